@@ -1,0 +1,95 @@
+//! Edges and the exact edge walk.
+//!
+//! Positions are in sub-pixels (1/256 px, [`crate::SUBPIXEL_BITS`]). A triangle is oriented so that its doubled area
+//! is positive; then the edge function of the directed edge `a -> b`,
+//! `E(p) = (b.x - a.x)(p.y - a.y) - (b.y - a.y)(p.x - a.x) = A p.x + B p.y + C`, is positive inside.
+//! A pixel whose centre `(256 i + 128, 256 j + 128)` has `E = 0` is covered only for a top edge (`A = 0, B > 0`:
+//! horizontal, interior below) or a left edge (`A > 0`: interior to the right): the top-left rule.
+//! So a pixel is covered iff `E(p) - bias >= 0` for all three edges, `bias = 0` on top-left edges and 1 otherwise.
+//!
+//! Per row, a left edge (`A > 0`) admits `i >= -floor(N / D)` and a right edge (`A < 0`) admits `i <= floor(N / D)`, with
+//! `N(j) = B (256 j + 128) + C - bias + 128 A` and `D = 256 |A|`. `N` grows by `256 B` a row, so `floor(N / D)` is
+//! walked exactly with a quotient and a remainder (a DDA): no division per row or pixel, only at setup.
+//! A horizontal edge admits a whole row or none: `N(j) >= 0`.
+//!
+//! Ranges: with vertices inside the guard band (`|x|, |y| < 2^20` sub-pixels) `|A|, |B| < 2^21`, `|C| < 2^42`, and
+//! `|N| < 2^44`: every quantity fits `i64` with room to spare (see ARCHITECTURE.md).
+
+/// A sub-pixel position.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Sub {
+    pub x: i32,
+    pub y: i32,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Side {
+    Left,
+    Right,
+    Flat,
+}
+
+/// One edge, walked row by row: `N = q D + r`, `0 <= r < D` (for a flat edge, `q` holds `N` itself).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Edge {
+    pub side: Side,
+    q: i64,
+    r: i64,
+    d: i64,
+    step_q: i64,
+    step_r: i64,
+}
+
+impl Edge {
+    /// The edge `a -> b` of a triangle with positive doubled area, positioned at row `j`.
+    pub fn new(a: Sub, b: Sub, j: i32) -> Edge {
+        let a_ = (a.y - b.y) as i64;
+        let b_ = (b.x - a.x) as i64;
+        let c = -(a_ * a.x as i64 + b_ * a.y as i64);
+        let top_left = a_ > 0 || (a_ == 0 && b_ > 0);
+        let bias = i64::from(!top_left);
+        let n = b_ * (256 * j as i64 + 128) + c - bias + 128 * a_;
+        let s = 256 * b_;
+        if a_ == 0 {
+            return Edge {
+                side: Side::Flat,
+                q: n,
+                r: 0,
+                d: 0,
+                step_q: s,
+                step_r: 0,
+            };
+        }
+        let d = 256 * a_.abs();
+        Edge {
+            side: if a_ > 0 { Side::Left } else { Side::Right },
+            q: n.div_euclid(d),
+            r: n.rem_euclid(d),
+            d,
+            step_q: s.div_euclid(d),
+            step_r: s.rem_euclid(d),
+        }
+    }
+
+    /// Moves to the next row.
+    #[inline(always)]
+    pub fn step(&mut self) {
+        self.q += self.step_q;
+        self.r += self.step_r;
+        if self.r >= self.d && self.d != 0 {
+            self.r -= self.d;
+            self.q += 1;
+        }
+    }
+
+    /// The bound this edge puts on the current row, as a half-open column range `[lo, hi)`.
+    #[inline(always)]
+    pub fn bound(&self) -> (i64, i64) {
+        match self.side {
+            Side::Left => (-self.q, i64::MAX),
+            Side::Right => (i64::MIN, self.q + 1),
+            Side::Flat if self.q >= 0 => (i64::MIN, i64::MAX),
+            Side::Flat => (0, 0),
+        }
+    }
+}

@@ -1,0 +1,55 @@
+//! The one error type of the crate.
+
+use core::fmt;
+
+/// Why a triangle, a render state or a buffer was refused. Nothing is written when one of these is returned.
+#[non_exhaustive]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Error {
+    /// A NaN or an infinity in a vertex field or a render-state value.
+    NonFinite,
+    /// `rhw <= 0` (or `-0.0`): the vertex is at or behind the eye, so `W = 1/rhw` is not a valid depth.
+    RhwNotPositive,
+    /// A vertex x or y outside the guard band `[-GUARD_BAND, GUARD_BAND]` pixels.
+    OutOfGuardBand,
+    /// `rhw * W_far` of a vertex is above [`crate::MAX_T`] (the vertex is more than `MAX_T` times nearer than the far plane).
+    DepthRange,
+    /// `W_near <= 0`, `W_far <= W_near`, or `W_far / W_near` above [`crate::MAX_T`].
+    InvalidDepthRange,
+    /// A depth buffer whose storage does not match its width and height.
+    BufferSize {
+        /// Elements the width and height need.
+        expected: usize,
+        /// Elements given.
+        actual: usize,
+    },
+    /// The colour target returned an error.
+    Target,
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::NonFinite => f.write_str("NaN or infinity in a vertex or render state"),
+            Error::RhwNotPositive => {
+                f.write_str("rhw must be > 0 (W = 1/rhw is the eye-space depth)")
+            }
+            Error::OutOfGuardBand => f.write_str("vertex outside the guard band of +-4096 pixels"),
+            Error::DepthRange => {
+                f.write_str("rhw * W_far above 2^24: vertex too near the eye for the depth range")
+            }
+            Error::InvalidDepthRange => {
+                f.write_str("depth range needs 0 < W_near < W_far and W_far/W_near <= 2^24")
+            }
+            Error::BufferSize { expected, actual } => {
+                write!(
+                    f,
+                    "depth buffer has {actual} elements, width x height needs {expected}"
+                )
+            }
+            Error::Target => f.write_str("the draw target returned an error"),
+        }
+    }
+}
+
+impl core::error::Error for Error {}

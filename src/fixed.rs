@@ -1,0 +1,87 @@
+//! Exact conversions from `f32` into the fixed-point formats of the pipeline, with integer operations only
+//! (no soft-float on cores without an FPU, bit-identical results on every target).
+
+/// An `f32` split into `(negative, mantissa, exponent)` with `|v| = mantissa * 2^exponent`; `None` for NaN and infinities.
+/// Zero and subnormals give a mantissa without the implicit bit (zero gives mantissa 0).
+#[inline]
+pub(crate) fn split(v: f32) -> Option<(bool, u32, i32)> {
+    let bits = v.to_bits();
+    let neg = bits >> 31 != 0;
+    let exp = ((bits >> 23) & 0xff) as i32;
+    let frac = bits & 0x7f_ffff;
+    match exp {
+        0xff => None,
+        0 => Some((neg, frac, -149)),
+        _ => Some((neg, frac | 0x80_0000, exp - 150)),
+    }
+}
+
+/// `round(m * 2^e)` for `m < 2^48`, ties to even, saturating at `i64::MAX` (callers range-check the input first).
+#[inline]
+pub(crate) fn round_shift(m: u64, e: i32) -> u64 {
+    if m == 0 {
+        return 0;
+    }
+    if e >= 0 {
+        if e >= 15 {
+            return i64::MAX as u64;
+        }
+        m << e
+    } else {
+        let s = (-e) as u32;
+        if s > 63 {
+            return 0;
+        }
+        let q = m >> s;
+        let rem = m & ((1u64 << s) - 1);
+        let half = 1u64 << (s - 1);
+        if rem > half || (rem == half && q & 1 == 1) {
+            q + 1
+        } else {
+            q
+        }
+    }
+}
+
+/// `v * 2^frac_bits` rounded to nearest (ties to even), for `|v| <= limit`; `Err(())` outside, `Err` for non-finite too.
+#[inline]
+pub(crate) fn to_fixed(v: f32, frac_bits: i32, limit_log2: i32) -> Result<i64, bool> {
+    let (neg, m, e) = split(v).ok_or(false)?;
+    // |v| < 2^(e + 24): reject anything at or above 2^limit (m has at most 24 bits).
+    if m != 0 && e + (32 - m.leading_zeros() as i32) > limit_log2 {
+        return Err(true);
+    }
+    let r = round_shift(m as u64, e + frac_bits) as i64;
+    Ok(if neg { -r } else { r })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn to_fixed_matches_exact_rounding() {
+        // Each value is exactly representable, so f64 gives the exact product; ties to even.
+        let cases: &[f32] = &[
+            0.0,
+            -0.0,
+            1.0,
+            0.5 / 256.0,
+            1.5 / 256.0,
+            2.5 / 256.0,
+            -2.5 / 256.0,
+            100.123,
+            -4095.99,
+            1e-30,
+        ];
+        for &v in cases {
+            let exact = (v as f64) * 256.0;
+            let want = exact.round_ties_even() as i64;
+            assert_eq!(to_fixed(v, 8, 12), Ok(want), "{v}");
+        }
+        assert_eq!(to_fixed(4096.0, 8, 12), Err(true));
+        assert_eq!(to_fixed(4095.9998, 8, 12), Ok(1_048_576)); // rounds up to 4096.0 * 256, inside the band
+        assert_eq!(to_fixed(f32::NAN, 8, 12), Err(false));
+        assert_eq!(to_fixed(f32::NEG_INFINITY, 8, 12), Err(false));
+    }
+}

@@ -1,0 +1,49 @@
+//! wraster: a `no_std` fixed-point triangle rasterizer with a W-buffer, for microcontrollers.
+//!
+//! It edge-walks triangles exactly (8 sub-pixel bits, top-left rule), interpolates `1/W` (RHW) in fixed point,
+//! recovers `W` per pixel with a Newton-Raphson reciprocal, and keeps depth in a packed 16-bit W-buffer
+//! (`round(W / W_far * 65535)`), whose precision is spread evenly over the depth range. Pixel centres are at
+//! `(i + 0.5, j + 0.5)`, as in Direct3D 10 and later and OpenGL.
+//!
+//! ```
+//! use embedded_graphics_core::pixelcolor::Rgb565;
+//! use embedded_graphics_core::prelude::*;
+//! use wraster::{DepthStore, Rasterizer, RenderState, Vertex};
+//!
+//! # struct Screen([Rgb565; 32 * 16]);
+//! # impl OriginDimensions for Screen { fn size(&self) -> Size { Size::new(32, 16) } }
+//! # impl DrawTarget for Screen {
+//! #     type Color = Rgb565; type Error = core::convert::Infallible;
+//! #     fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(&mut self, px: I) -> Result<(), Self::Error> {
+//! #         for Pixel(p, c) in px { if let Ok(x) = usize::try_from(p.x + p.y * 32) { if x < 512 { self.0[x] = c } } }
+//! #         Ok(())
+//! #     }
+//! # }
+//! # let mut screen = Screen([Rgb565::BLACK; 32 * 16]);
+//! let mut depth = DepthStore::<32, 16>::new();
+//! let mut r: Rasterizer = Rasterizer::new(RenderState::new(10.0, 1000.0)?);
+//! let tri = [
+//!     Vertex::new(1.5, 1.5, 20.0, Rgb565::RED),
+//!     Vertex::new(30.5, 4.5, 900.0, Rgb565::RED),
+//!     Vertex::new(6.5, 14.5, 100.0, Rgb565::RED),
+//! ];
+//! let stats = r.draw(&mut screen, &mut depth.view(), &tri)?;
+//! assert!(stats.written > 100);
+//! # Ok::<(), wraster::Error>(())
+//! ```
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+mod depth;
+mod edge;
+mod error;
+mod fixed;
+mod raster;
+pub mod recip;
+mod state;
+
+pub use depth::{DepthBuffer, DepthStore, W16_FAR};
+pub use error::Error;
+pub use raster::{Rasterizer, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS};
+pub use state::{Compare, Cull, DepthRange, RenderState, MAX_T};

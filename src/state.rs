@@ -1,0 +1,144 @@
+//! Render state: depth range, comparison, depth write, culling.
+
+use crate::fixed::split;
+use crate::Error;
+
+/// The largest `W_far / W_near`, and the largest `rhw * W_far` of a vertex: `2^30`.
+/// It keeps `t = W_far * rhw` in the plane's 62 bits with at least 30 fraction bits (see ARCHITECTURE.md).
+pub const MAX_T: f32 = (1u32 << 30) as f32;
+pub(crate) const MAX_T_LOG2: i32 = 30;
+
+/// The depth comparison `new CMP stored` of seed 001_4caa61ee3442653f.txt (D3DMCMPFUNC). For the W-buffer, smaller is
+/// nearer, so `Less` keeps the nearest surface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compare {
+    /// Never passes.
+    Never,
+    /// `new < stored`.
+    Less,
+    /// `new == stored`.
+    Equal,
+    /// `new <= stored`.
+    LessEqual,
+    /// `new > stored`.
+    Greater,
+    /// `new != stored`.
+    NotEqual,
+    /// `new >= stored`.
+    GreaterEqual,
+    /// Always passes.
+    Always,
+}
+
+impl Compare {
+    /// The comparison on two stored codes.
+    #[inline(always)]
+    pub fn test(self, new: u16, stored: u16) -> bool {
+        match self {
+            Compare::Never => false,
+            Compare::Less => new < stored,
+            Compare::Equal => new == stored,
+            Compare::LessEqual => new <= stored,
+            Compare::Greater => new > stored,
+            Compare::NotEqual => new != stored,
+            Compare::GreaterEqual => new >= stored,
+            Compare::Always => true,
+        }
+    }
+}
+
+/// Which screen-space winding is dropped. Pixel y grows downwards, so "clockwise" is as seen on the display.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cull {
+    /// Draw both windings.
+    None,
+    /// Drop triangles whose vertices run clockwise on screen.
+    Cw,
+    /// Drop triangles whose vertices run counter-clockwise on screen (Direct3D's default).
+    Ccw,
+}
+
+/// The eye-space depth range `[W_near, W_far]`, checked: `0 < W_near < W_far`, both finite, ratio at most [`MAX_T`].
+/// Seed 000_92e7aa22df8423f2.txt: "W_near must be greater than zero. W_far must be greater than W_near."
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthRange {
+    near: f32,
+    far: f32,
+    /// `far / near = ratio_m / ratio_d * 2^ratio_e`, exactly (both mantissas of the f32s).
+    ratio_m: u64,
+    ratio_d: u64,
+    ratio_e: i32,
+}
+
+impl DepthRange {
+    /// Checks and stores the range.
+    pub fn new(w_near: f32, w_far: f32) -> Result<Self, Error> {
+        let (nn, mn, en) = split(w_near).ok_or(Error::NonFinite)?;
+        let (nf, mf, ef) = split(w_far).ok_or(Error::NonFinite)?;
+        if nn || nf || mn == 0 || w_far <= w_near {
+            return Err(Error::InvalidDepthRange);
+        }
+        // far/near <= 2^30  <=>  mf * 2^ef <= mn * 2^(en + 30), compared exactly.
+        let lhs = mf as u128;
+        let sh = en + MAX_T_LOG2 - ef;
+        let ok = if sh >= 0 {
+            sh >= 100 || lhs <= (mn as u128) << sh
+        } else {
+            (-sh) < 100 && lhs <= (mn as u128) >> (-sh)
+        };
+        if !ok {
+            return Err(Error::InvalidDepthRange);
+        }
+        Ok(DepthRange {
+            near: w_near,
+            far: w_far,
+            ratio_m: mf as u64,
+            ratio_d: mn as u64,
+            ratio_e: ef - en,
+        })
+    }
+    /// `W_near`.
+    pub fn near(&self) -> f32 {
+        self.near
+    }
+    /// `W_far`.
+    pub fn far(&self) -> f32 {
+        self.far
+    }
+    /// `floor(far / near * 2^frac)`: the largest `T = t * 2^frac` still at or beyond the near plane.
+    pub(crate) fn t_max(&self, frac: u32) -> u64 {
+        let e = self.ratio_e + frac as i32;
+        let num = self.ratio_m as u128;
+        let q = if e >= 0 {
+            (num << e) / self.ratio_d as u128
+        } else {
+            (num >> (-e).min(127)) / self.ratio_d as u128
+        };
+        q.min(u64::MAX as u128) as u64
+    }
+}
+
+/// Everything a draw call needs besides the geometry and the buffers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderState {
+    /// The depth range; W outside it is not drawn.
+    pub range: DepthRange,
+    /// The depth comparison.
+    pub compare: Compare,
+    /// Whether passing pixels store their depth.
+    pub depth_write: bool,
+    /// Face culling.
+    pub cull: Cull,
+}
+
+impl RenderState {
+    /// `Less`, depth write on, no culling, over `[w_near, w_far]`.
+    pub fn new(w_near: f32, w_far: f32) -> Result<Self, Error> {
+        Ok(RenderState {
+            range: DepthRange::new(w_near, w_far)?,
+            compare: Compare::Less,
+            depth_write: true,
+            cull: Cull::None,
+        })
+    }
+}
