@@ -41,6 +41,8 @@ mod error;
 mod fixed;
 mod raster;
 pub mod recip;
+#[cfg(feature = "scenes")]
+pub mod scenes;
 mod state;
 
 pub use depth::{DepthBuffer, DepthStore, W16_FAR};

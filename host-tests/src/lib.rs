@@ -1,1 +1,275 @@
-//! Host-side tools for wraster: the f64 reference rasterizer, the standard scenes, a framebuffer target.
+//! Host-side tools for wraster: a checked framebuffer, the independent f64 reference rasterizer, render helpers.
+//!
+//! The reference shares with the core only the rules and the snapped vertices: snapping (round to nearest, ties to
+//! even, 8 bits), the top-left rule and the W16 encoding `round(W / W_far * 65535)`. Its arithmetic is its own:
+//! coverage by evaluating the three edge functions at every pixel centre in i64, and W at each centre by barycentric
+//! perspective interpolation of `1/W` in f64.
+
+use embedded_graphics::pixelcolor::Rgb565;
+use embedded_graphics::prelude::*;
+use embedded_graphics::primitives::Rectangle;
+use wraster::recip::SpanRecip;
+use wraster::{DepthBuffer, Error, Rasterizer, RenderState, Stats, Vertex};
+
+/// A colour framebuffer that counts writes per pixel and panics on any write outside it.
+#[derive(Clone, PartialEq, Eq, Debug)]
+pub struct Frame {
+    /// Width in pixels.
+    pub w: u32,
+    /// Height in pixels.
+    pub h: u32,
+    /// Colours, row-major.
+    pub px: Vec<Rgb565>,
+    /// Writes per pixel.
+    pub writes: Vec<u32>,
+}
+
+impl Frame {
+    /// A black frame.
+    pub fn new(w: u32, h: u32) -> Self {
+        Frame {
+            w,
+            h,
+            px: vec![Rgb565::BLACK; (w * h) as usize],
+            writes: vec![0; (w * h) as usize],
+        }
+    }
+    fn put(&mut self, p: Point, c: Rgb565) {
+        assert!(
+            p.x >= 0 && p.y >= 0 && (p.x as u32) < self.w && (p.y as u32) < self.h,
+            "write outside the frame at {p:?}"
+        );
+        let k = (p.y as u32 * self.w + p.x as u32) as usize;
+        self.px[k] = c;
+        self.writes[k] += 1;
+    }
+    /// Saves as a PNG through embedded-graphics-simulator.
+    pub fn save_png(&self, path: &std::path::Path) {
+        use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay};
+        let mut d = SimulatorDisplay::<Rgb565>::new(Size::new(self.w, self.h));
+        for (k, c) in self.px.iter().enumerate() {
+            let p = Point::new((k as u32 % self.w) as i32, (k as u32 / self.w) as i32);
+            Pixel(p, *c).draw(&mut d).unwrap();
+        }
+        let img = d.to_rgb_output_image(
+            &OutputSettingsBuilder::new()
+                .scale(1)
+                .pixel_spacing(0)
+                .build(),
+        );
+        if let Some(dir) = path.parent() {
+            std::fs::create_dir_all(dir).unwrap();
+        }
+        img.save_png(path).unwrap();
+    }
+}
+
+impl OriginDimensions for Frame {
+    fn size(&self) -> Size {
+        Size::new(self.w, self.h)
+    }
+}
+
+impl DrawTarget for Frame {
+    type Color = Rgb565;
+    type Error = core::convert::Infallible;
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(
+        &mut self,
+        pixels: I,
+    ) -> Result<(), Self::Error> {
+        for Pixel(p, c) in pixels {
+            self.put(p, c);
+        }
+        Ok(())
+    }
+    fn fill_solid(&mut self, area: &Rectangle, c: Rgb565) -> Result<(), Self::Error> {
+        for p in area.points() {
+            self.put(p, c);
+        }
+        Ok(())
+    }
+}
+
+/// Snaps a coordinate to 1/256 pixel, round to nearest, ties to even (the shared rule).
+pub fn snap(v: f32) -> i64 {
+    (v as f64 * 256.0).round_ties_even() as i64
+}
+
+/// A covered pixel of the reference.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RefPixel {
+    /// Column.
+    pub x: i32,
+    /// Row.
+    pub y: i32,
+    /// `t = W_far / W` at the pixel centre.
+    pub t: f64,
+    /// Whether `W_near <= W <= W_far`.
+    pub in_range: bool,
+    /// `round(65535 / t)`, the W16 code (meaningful when in range).
+    pub code: u16,
+}
+
+/// The reference's pixels of one triangle inside columns `[0, width)` and rows `rows`, in row-major order.
+/// `None` when the triangle has zero snapped area.
+pub fn reference_tri(
+    v: &[(f32, f32, f32); 3],
+    near: f32,
+    far: f32,
+    width: i32,
+    rows: std::ops::Range<i32>,
+) -> Option<Vec<RefPixel>> {
+    // v: (x, y, rhw)
+    let mut p: Vec<(i64, i64, f64)> = v
+        .iter()
+        .map(|&(x, y, rhw)| (snap(x), snap(y), rhw as f64 * far as f64))
+        .collect();
+    let e = |a: (i64, i64, f64), b: (i64, i64, f64), px: i64, py: i64| {
+        (b.0 - a.0) * (py - a.1) - (b.1 - a.1) * (px - a.0)
+    };
+    let area = e(p[0], p[1], p[2].0, p[2].1);
+    if area == 0 {
+        return None;
+    }
+    if area < 0 {
+        p.swap(1, 2);
+    }
+    let area = area.abs() as f64;
+    // top-left: a left edge runs upwards (a.y > b.y); a top edge is horizontal and runs rightwards.
+    let tl = |a: (i64, i64, f64), b: (i64, i64, f64)| a.1 > b.1 || (a.1 == b.1 && b.0 > a.0);
+    let edges = [(p[1], p[2], 0usize), (p[2], p[0], 1), (p[0], p[1], 2)];
+    let x0 = (p.iter().map(|q| q.0).min().unwrap() >> 8).max(0);
+    let x1 = ((p.iter().map(|q| q.0).max().unwrap() >> 8) + 1).min(width as i64 - 1);
+    let y0 = (p.iter().map(|q| q.1).min().unwrap() >> 8).max(rows.start as i64);
+    let y1 = ((p.iter().map(|q| q.1).max().unwrap() >> 8) + 1).min(rows.end as i64 - 1);
+    let mut out = Vec::new();
+    for j in y0..=y1 {
+        for i in x0..=x1 {
+            let (px, py) = (256 * i + 128, 256 * j + 128);
+            let mut w = [0f64; 3];
+            let mut inside = true;
+            for &(a, b, k) in &edges {
+                let ev = e(a, b, px, py);
+                if ev < 0 || (ev == 0 && !tl(a, b)) {
+                    inside = false;
+                    break;
+                }
+                w[k] = ev as f64;
+            }
+            if !inside {
+                continue;
+            }
+            let t = (w[0] * p[0].2 + w[1] * p[1].2 + w[2] * p[2].2) / area;
+            let in_range = t >= 1.0 && t * near as f64 <= far as f64;
+            let code = (65535.0 / t).round().clamp(0.0, 65535.0) as u16;
+            out.push(RefPixel {
+                x: i as i32,
+                y: j as i32,
+                t,
+                in_range,
+                code,
+            });
+        }
+    }
+    Some(out)
+}
+
+/// The reference's final frame for a list of triangles with a `Less` test on exact W: colour, the exact `1/t` of the
+/// nearest surface, and its W16 code (65535 and 1.0 where nothing was drawn).
+pub struct RefFrame {
+    /// Colours.
+    pub px: Vec<Rgb565>,
+    /// `W / W_far` of the visible surface.
+    pub depth: Vec<f64>,
+    /// The W16 code of the visible surface.
+    pub code: Vec<u16>,
+    /// The exact depth of the second-nearest surface drawn at each pixel (`f64::INFINITY` if none): where it is within
+    /// 2 LSB of the nearest, either may win in a W16 buffer.
+    pub runner_up: Vec<f64>,
+}
+
+/// Renders `tris` with the reference.
+pub fn reference_frame(
+    tris: &[[Vertex<Rgb565>; 3]],
+    near: f32,
+    far: f32,
+    w: u32,
+    h: u32,
+) -> RefFrame {
+    let n = (w * h) as usize;
+    let mut f = RefFrame {
+        px: vec![Rgb565::BLACK; n],
+        depth: vec![1.0; n],
+        code: vec![65535; n],
+        runner_up: vec![f64::INFINITY; n],
+    };
+    let mut best = vec![f64::INFINITY; n];
+    for tri in tris {
+        let v = tri.map(|q| (q.x, q.y, q.rhw));
+        for p in reference_tri(&v, near, far, w as i32, 0..h as i32).unwrap_or_default() {
+            if !p.in_range {
+                continue;
+            }
+            let k = (p.y as u32 * w + p.x as u32) as usize;
+            let d = 1.0 / p.t;
+            if d < best[k] {
+                f.runner_up[k] = best[k];
+                best[k] = d;
+                f.px[k] = tri[0].color;
+                f.depth[k] = d;
+                f.code[k] = p.code;
+            } else if d < f.runner_up[k] {
+                f.runner_up[k] = d;
+            }
+        }
+    }
+    f
+}
+
+/// Renders `tris` into a `w x h` frame with `bands` depth bands of `band_h` rows (the last may be shorter), each
+/// cleared before its pass; returns the frame, the whole-frame depth and the summed stats.
+pub fn render<R: SpanRecip>(
+    tris: &[[Vertex<Rgb565>; 3]],
+    state: RenderState,
+    w: u16,
+    h: u16,
+    band_h: u16,
+) -> Result<(Frame, Vec<u16>, Stats), Error> {
+    let mut frame = Frame::new(w as u32, h as u32);
+    let mut depth = vec![0u16; w as usize * h as usize];
+    let mut r = Rasterizer::<R>::new(state);
+    let mut stats = Stats::default();
+    let mut y0 = 0u16;
+    while y0 < h {
+        let bh = band_h.min(h - y0);
+        let slice = &mut depth[y0 as usize * w as usize..(y0 + bh) as usize * w as usize];
+        let mut buf = DepthBuffer::band(slice, w, y0 as i32, bh)?;
+        buf.clear();
+        for t in tris {
+            stats += r.draw(&mut frame, &mut buf, t)?;
+        }
+        y0 += bh;
+    }
+    Ok((frame, depth, stats))
+}
+
+/// A small xorshift64 generator for reproducible tests.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// Next 64 random bits.
+    pub fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    /// Uniform in `[lo, hi)`.
+    pub fn f(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Log-uniform in `[lo, hi)`.
+    pub fn log(&mut self, lo: f64, hi: f64) -> f64 {
+        (self.f(lo.ln(), hi.ln())).exp()
+    }
+}
