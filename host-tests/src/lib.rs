@@ -258,7 +258,7 @@ pub struct Rng(pub u64);
 
 impl Rng {
     /// Next 64 random bits.
-    pub fn next(&mut self) -> u64 {
+    pub fn bits(&mut self) -> u64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
@@ -266,7 +266,7 @@ impl Rng {
     }
     /// Uniform in `[lo, hi)`.
     pub fn f(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+        lo + (hi - lo) * (self.bits() >> 11) as f64 / (1u64 << 53) as f64
     }
     /// Log-uniform in `[lo, hi)`.
     pub fn log(&mut self, lo: f64, hi: f64) -> f64 {

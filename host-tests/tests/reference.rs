@@ -13,7 +13,7 @@ const H: u16 = 64;
 /// sub-pixel tie (half-way between two 1/256 steps, which rounds to even).
 fn coord(rng: &mut Rng, extent: f64) -> f32 {
     let v = rng.f(-0.3 * extent, 1.3 * extent);
-    match rng.next() % 4 {
+    match rng.bits() % 4 {
         0 => (v.floor() + 0.5) as f32,
         1 => ((v * 256.0).floor() / 256.0 + 1.0 / 512.0) as f32,
         _ => v as f32,
@@ -23,11 +23,11 @@ fn coord(rng: &mut Rng, extent: f64) -> f32 {
 /// A random triangle: sizes from sub-pixel slivers to much larger than the frame, both windings.
 fn random_tri(rng: &mut Rng, wmin: f64, wmax: f64) -> [Vertex<Rgb565>; 3] {
     let c = Rgb565::new(
-        (rng.next() % 32) as u8,
-        (rng.next() % 64) as u8,
-        (rng.next() % 32) as u8,
+        (rng.bits() % 32) as u8,
+        (rng.bits() % 64) as u8,
+        (rng.bits() % 32) as u8,
     );
-    let kind = rng.next() % 4;
+    let kind = rng.bits() % 4;
     let (x, y) = (coord(rng, W as f64), coord(rng, H as f64));
     let spread = match kind {
         0 => 0.5,
@@ -41,7 +41,7 @@ fn random_tri(rng: &mut Rng, wmin: f64, wmax: f64) -> [Vertex<Rgb565>; 3] {
         q.y = y + rng.f(-spread, spread) as f32;
         q.rhw = 1.0 / rng.log(wmin, wmax) as f32;
     }
-    if kind == 0 && rng.next() % 2 == 0 {
+    if kind == 0 && rng.bits() % 2 == 0 {
         // a sliver: the third vertex nearly on the line of the first two
         let s = rng.f(0.0, 1.0) as f32;
         v[2].x = v[0].x + s * (v[1].x - v[0].x) + 1.0 / 512.0;
