@@ -41,7 +41,7 @@ fn random_tri(rng: &mut Rng, wmin: f64, wmax: f64) -> [Vertex<Rgb565>; 3] {
         q.y = y + rng.f(-spread, spread) as f32;
         q.rhw = 1.0 / rng.log(wmin, wmax) as f32;
     }
-    if kind == 0 && rng.bits() % 2 == 0 {
+    if kind == 0 && rng.bits().is_multiple_of(2) {
         // a sliver: the third vertex nearly on the line of the first two
         let s = rng.f(0.0, 1.0) as f32;
         v[2].x = v[0].x + s * (v[1].x - v[0].x) + 1.0 / 512.0;
