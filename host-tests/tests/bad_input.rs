@@ -1,6 +1,6 @@
 //! Bad input gets a clear error, nothing is written, nothing panics.
 
-use embedded_graphics::pixelcolor::Rgb565;
+use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
 use host_tests::Frame;
 use wraster::{
     DepthBuffer, DepthRange, DepthStore, Error, Rasterizer, RenderState, Vertex, W16_FAR,

@@ -20,10 +20,10 @@ fn main() {
     // Error: the final stored code against the reference's code of the visible surface, at every drawn pixel.
     let reference = reference_frame(&tris, near, far, WIDTH as u32, HEIGHT as u32);
     let (mut drawn, mut max_err, mut sum_err) = (0u64, 0i64, 0i64);
-    for k in 0..depth.len() {
-        if frame.writes[k] > 0 {
+    for ((&d, &writes), &want) in depth.iter().zip(&frame.writes).zip(&reference.code) {
+        if writes > 0 {
             drawn += 1;
-            let e = (depth[k] as i64 - reference.code[k] as i64).abs();
+            let e = (d as i64 - want as i64).abs();
             max_err = max_err.max(e);
             sum_err += e;
         }
