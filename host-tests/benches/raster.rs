@@ -31,6 +31,11 @@ fn scenes(c: &mut Criterion) {
     let mut g = c.benchmark_group("scene");
     for scene in Scene::ALL {
         let written = draw_scene::<PerPixel<DefaultRecip>>(scene, &mut frame, &mut depth);
+        println!(
+            "scene={} triangles={} written={written}",
+            scene.name(),
+            scene.len()
+        );
         g.throughput(Throughput::Elements(if scene == Scene::Small {
             scene.len() as u64
         } else {
