@@ -21,6 +21,8 @@ use crate::fixed::{round_shift, split, to_fixed};
 use crate::recip::{DefaultRecip, PerPixel, SpanRecip};
 use crate::state::{Cull, RenderState, MAX_T_LOG2};
 use crate::Error;
+#[cfg(feature = "gouraud")]
+use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 
 /// Fraction bits of snapped x and y (Direct3D 11's 16.8).
 pub const SUBPIXEL_BITS: u32 = 8;
@@ -76,7 +78,7 @@ impl core::ops::AddAssign for Stats {
     }
 }
 
-/// A triangle after snapping and checks, ready to walk.
+/// A triangle after snapping and checks.
 struct Setup {
     p: [Sub; 3],
     t: [i64; 3],
@@ -155,7 +157,68 @@ impl<R: SpanRecip> Rasterizer<R> {
         Ok(Setup { p, t, frac })
     }
 
-    /// Draws one triangle. On an error nothing is written.
+    /// Snaps, checks, culls and clips a triangle to the buffer's rows, and solves its `t` plane.
+    /// `Ok(Err(stats))` when there is nothing to walk (culled, or no row in the buffer).
+    fn prepare<C>(
+        &self,
+        v: &[Vertex<C>; 3],
+        depth: &DepthBuffer<'_>,
+    ) -> Result<Result<Walk, Stats>, Error> {
+        let s = self.setup(v)?;
+        let [p0, p1, p2] = s.p;
+        let area = (p1.x - p0.x) as i64 * (p2.y - p0.y) as i64
+            - (p2.x - p0.x) as i64 * (p1.y - p0.y) as i64;
+        let culled = Stats {
+            culled: 1,
+            ..Stats::default()
+        };
+        match self.state.cull {
+            _ if area == 0 => return Ok(Err(culled)),
+            Cull::Cw if area > 0 => return Ok(Err(culled)),
+            Cull::Ccw if area < 0 => return Ok(Err(culled)),
+            _ => {}
+        }
+        // Orient so the doubled area is positive (inside = positive edge functions).
+        let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
+        let p = order.map(|k| s.p[k]);
+
+        // Rows whose centre lies in the vertices' y-range, clipped to the buffer.
+        let ymin = p[0].y.min(p[1].y).min(p[2].y);
+        let ymax = p[0].y.max(p[1].y).max(p[2].y);
+        let j_first = (ymin as i64 - 128 + 255).div_euclid(256) as i32; // ceil((ymin - 128) / 256)
+        let j_last = (ymax as i64 - 128).div_euclid(256) as i32;
+        let j0 = j_first.max(depth.y0());
+        let j1 = j_last.min(depth.y0() + depth.height() as i32 - 1);
+        if j0 > j1 {
+            return Ok(Err(Stats::default()));
+        }
+        let xmin = p[0].x.min(p[1].x).min(p[2].x);
+        let geom = Geom {
+            p,
+            area: area.unsigned_abs() as i128,
+            i_ref: (xmin >> SUBPIXEL_BITS) as i64,
+            j0,
+        };
+        let t = Plane::solve(order.map(|k| s.t[k]), &geom);
+        Ok(Ok(Walk {
+            edges: [
+                Edge::new(p[0], p[1], j0),
+                Edge::new(p[1], p[2], j0),
+                Edge::new(p[2], p[0], j0),
+            ],
+            geom,
+            order,
+            j1,
+            t,
+            span: SpanCtx {
+                t_lo: 1u64 << s.frac,
+                t_hi: self.state.range.t_max(s.frac),
+                shift_base: 94 - s.frac,
+            },
+        }))
+    }
+
+    /// Draws one flat-coloured triangle (the colour of its first vertex). On an error nothing is written.
     pub fn draw<D>(
         &mut self,
         target: &mut D,
@@ -166,150 +229,227 @@ impl<R: SpanRecip> Rasterizer<R> {
         D: DrawTarget,
         D::Color: PixelColor,
     {
-        let s = self.setup(v)?;
-        let [p0, mut p1, mut p2] = s.p;
-        let [t0, mut t1, mut t2] = s.t;
-        let area = (p1.x - p0.x) as i64 * (p2.y - p0.y) as i64
-            - (p2.x - p0.x) as i64 * (p1.y - p0.y) as i64;
-        let culled = Stats {
-            culled: 1,
-            ..Stats::default()
+        let mut w = match self.prepare(v, depth)? {
+            Ok(w) => w,
+            Err(stats) => return Ok(stats),
         };
-        match self.state.cull {
-            _ if area == 0 => return Ok(culled),
-            Cull::Cw if area > 0 => return Ok(culled),
-            Cull::Ccw if area < 0 => return Ok(culled),
-            _ => {}
-        }
-        if area < 0 {
-            core::mem::swap(&mut p1, &mut p2);
-            core::mem::swap(&mut t1, &mut t2);
-        }
-        let area = area.abs();
-
-        // Rows whose centre lies in the vertices' y-range, clipped to the buffer.
-        let ymin = p0.y.min(p1.y).min(p2.y);
-        let ymax = p0.y.max(p1.y).max(p2.y);
-        let j_first = ((ymin - 128) as i64).div_euclid(256) as i32 + 1
-            - i32::from((ymin - 128).rem_euclid(256) == 0);
-        let j_last = ((ymax - 128) as i64).div_euclid(256) as i32;
-        let j0 = j_first.max(depth.y0());
-        let j1 = j_last.min(depth.y0() + depth.height() as i32 - 1);
-        if j0 > j1 {
-            return Ok(Stats::default());
-        }
-
-        // The t plane, exactly: T(X, Y) = T0 + (gx (X - X0) + gy (Y - Y0)) / area, X, Y in sub-pixels.
-        let (dt1, dt2) = (t1 as i128 - t0 as i128, t2 as i128 - t0 as i128);
-        let gx = dt1 * (p2.y - p0.y) as i128 - dt2 * (p1.y - p0.y) as i128;
-        let gy = dt2 * (p1.x - p0.x) as i128 - dt1 * (p2.x - p0.x) as i128;
-        let a = area as i128;
-        let step_x = div_round(gx * 256, a) as i64; // wraps for slivers: see the module doc
-        let step_y = div_round(gy * 256, a) as i64;
-        let xmin = p0.x.min(p1.x).min(p2.x);
-        let i_ref = (xmin >> SUBPIXEL_BITS) as i64;
-        let (rx, ry) = (
-            256 * i_ref as i128 + 128 - p0.x as i128,
-            256 * j0 as i128 + 128 - p0.y as i128,
-        );
-        let mut t_row = (t0 as i128 + div_round(gx * rx + gy * ry, a)) as i64;
-
-        let mut edges = [
-            Edge::new(p0, p1, j0),
-            Edge::new(p1, p2, j0),
-            Edge::new(p2, p0, j0),
-        ];
-        let t_near = self.state.range.t_max(s.frac);
-        let span = SpanCtx {
-            t_lo: 1u64 << s.frac,
-            t_hi: t_near,
-            shift_base: 94 - s.frac,
-            step_x,
-        };
-        let width = depth.width() as i64;
         let color = v[0].color;
         let mut stats = Stats::default();
-        for j in j0..=j1 {
-            let (mut lo, mut hi) = (0i64, width);
-            for e in &edges {
-                let (l, h) = e.bound();
-                lo = lo.max(l);
-                hi = hi.min(h);
+        for j in w.geom.j0..=w.j1 {
+            if let Some((lo, hi)) = w.row(depth.width()) {
+                let mut t = w.t.at(lo as i64 - w.geom.i_ref) as u64;
+                let (cmp, write) = (self.state.compare, self.state.depth_write);
+                let row = depth.row_mut(j);
+                self.recip.begin_span(t, w.t.sx, (hi - lo) as u32);
+                let mut run_start = lo;
+                for i in lo..hi {
+                    let mut pass = false;
+                    if t >= w.span.t_lo && t <= w.span.t_hi {
+                        let inv = self.recip.recip(t);
+                        let code = encode_w16(inv.x, w.span.shift_base - inv.lz);
+                        let stored = &mut row[i as usize];
+                        if cmp.test(code, *stored) {
+                            if write {
+                                *stored = code;
+                            }
+                            pass = true;
+                        }
+                    }
+                    if !pass {
+                        if run_start < i {
+                            fill(target, run_start, i, j, color)?;
+                        }
+                        run_start = i + 1;
+                    } else {
+                        stats.written += 1;
+                    }
+                    t = t.wrapping_add(w.t.sx as u64);
+                }
+                if run_start < hi {
+                    fill(target, run_start, hi, j, color)?;
+                }
+                stats.fragments += (hi - lo) as u32;
             }
-            if lo < hi {
-                let t = t_row.wrapping_add(step_x.wrapping_mul(lo - i_ref));
-                let st = self.span(target, depth, j, lo as i32, hi as i32, t, &span, color)?;
-                stats += st;
-            }
-            for e in &mut edges {
-                e.step();
-            }
-            t_row = t_row.wrapping_add(step_y);
+            w.next_row();
         }
         Ok(stats)
     }
 
-    #[allow(clippy::too_many_arguments)]
-    #[inline]
-    fn span<D>(
+    /// Draws one triangle with its vertex colours interpolated perspective-correctly (feature `gouraud`): each
+    /// channel `c` is carried as the plane of `c * t` (linear in screen space) and divided per pixel by `t` with the
+    /// same reciprocal as the depth, then rounded to 8 bits. On an error nothing is written.
+    #[cfg(feature = "gouraud")]
+    pub fn draw_gouraud<D>(
         &mut self,
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
-        j: i32,
-        lo: i32,
-        hi: i32,
-        t: i64,
-        c: &SpanCtx,
-        color: D::Color,
+        v: &[Vertex<D::Color>; 3],
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
+        D::Color: PixelColor + From<Rgb888> + Into<Rgb888>,
     {
-        let (cmp, write) = (self.state.compare, self.state.depth_write);
-        let row = depth.row_mut(j);
-        let mut t = t as u64;
-        self.recip.begin_span(t, c.step_x, (hi - lo) as u32);
-        let mut run_start = lo;
-        let mut written = 0;
-        for i in lo..hi {
-            let mut pass = false;
-            if t >= c.t_lo && t <= c.t_hi {
-                let inv = self.recip.recip(t);
-                let code = encode_w16(inv.x, c.shift_base - inv.lz);
-                let stored = &mut row[i as usize];
-                if cmp.test(code, *stored) {
-                    if write {
-                        *stored = code;
+        let s_t = self.setup(v)?.t;
+        let mut w = match self.prepare(v, depth)? {
+            Ok(w) => w,
+            Err(stats) => return Ok(stats),
+        };
+        // Q = c * (T >> 8) < T for c <= 255, so Q << lz fits wherever T << lz does.
+        let rgb = v.map(|q| {
+            let c: Rgb888 = q.color.into();
+            [c.r(), c.g(), c.b()]
+        });
+        let mut planes = [0, 1, 2]
+            .map(|ch| Plane::solve(w.order.map(|k| rgb[k][ch] as i64 * (s_t[k] >> 8)), &w.geom));
+        let mut buf = [D::Color::from(Rgb888::BLACK); 32];
+        let mut stats = Stats::default();
+        for j in w.geom.j0..=w.j1 {
+            if let Some((lo, hi)) = w.row(depth.width()) {
+                let (cmp, write) = (self.state.compare, self.state.depth_write);
+                let row = depth.row_mut(j);
+                let off = lo as i64 - w.geom.i_ref;
+                let mut t = w.t.at(off) as u64;
+                let mut q = planes.map(|p| p.at(off));
+                self.recip.begin_span(t, w.t.sx, (hi - lo) as u32);
+                let (mut run_start, mut n) = (lo, 0usize);
+                for i in lo..hi {
+                    let mut pass = false;
+                    if t >= w.span.t_lo && t <= w.span.t_hi {
+                        let inv = self.recip.recip(t);
+                        let code = encode_w16(inv.x, w.span.shift_base - inv.lz);
+                        let stored = &mut row[i as usize];
+                        if cmp.test(code, *stored) {
+                            if write {
+                                *stored = code;
+                            }
+                            pass = true;
+                            // c = 256 Q / T = q x 2^-54 with q = (Q << lz) >> 32 (ARCHITECTURE.md)
+                            let ch = q.map(|qq| {
+                                let qn = ((qq.max(0) as u64) << inv.lz) >> 32;
+                                ((qn * inv.x as u64 + (1 << 53)) >> 54).min(255) as u8
+                            });
+                            buf[n] = D::Color::from(Rgb888::new(ch[0], ch[1], ch[2]));
+                            n += 1;
+                        }
                     }
-                    pass = true;
+                    if (!pass || n == buf.len()) && n > 0 {
+                        let end = if pass { i + 1 } else { i };
+                        let r = Rectangle::new(Point::new(run_start, j), Size::new(n as u32, 1));
+                        target
+                            .fill_contiguous(&r, buf[..n].iter().copied())
+                            .map_err(|_| Error::Target)?;
+                        run_start = end;
+                        n = 0;
+                    }
+                    if !pass {
+                        run_start = i + 1;
+                    } else {
+                        stats.written += 1;
+                    }
+                    t = t.wrapping_add(w.t.sx as u64);
+                    for (qq, p) in q.iter_mut().zip(&planes) {
+                        *qq = qq.wrapping_add(p.sx);
+                    }
                 }
-            }
-            if !pass {
-                if run_start < i {
-                    fill(target, run_start, i, j, color)?;
+                if n > 0 {
+                    let r = Rectangle::new(Point::new(run_start, j), Size::new(n as u32, 1));
+                    target
+                        .fill_contiguous(&r, buf[..n].iter().copied())
+                        .map_err(|_| Error::Target)?;
                 }
-                run_start = i + 1;
-            } else {
-                written += 1;
+                stats.fragments += (hi - lo) as u32;
             }
-            t = t.wrapping_add(c.step_x as u64);
+            w.next_row();
+            for p in &mut planes {
+                p.next_row();
+            }
         }
-        if run_start < hi {
-            fill(target, run_start, hi, j, color)?;
-        }
-        Ok(Stats {
-            fragments: (hi - lo) as u32,
-            written,
-            culled: 0,
-        })
+        Ok(stats)
     }
 }
 
+/// Positions of the oriented triangle and the reference pixel of its planes: column `i_ref`, row `j0`.
+struct Geom {
+    p: [Sub; 3],
+    area: i128,
+    i_ref: i64,
+    j0: i32,
+}
+
+/// A quantity linear in screen space: its value at `(i_ref, current row)` and its steps per column and row.
+#[derive(Clone, Copy)]
+struct Plane {
+    row: i64,
+    sx: i64,
+    sy: i64,
+}
+
+impl Plane {
+    /// Solves `V(X, Y) = V0 + (gx (X - X0) + gy (Y - Y0)) / area` exactly in i128 (X, Y in sub-pixels) and rounds
+    /// the steps and the reference value once each. Steps may wrap for slivers (see the module doc).
+    fn solve(v: [i64; 3], g: &Geom) -> Plane {
+        let [p0, p1, p2] = g.p;
+        let (d1, d2) = (v[1] as i128 - v[0] as i128, v[2] as i128 - v[0] as i128);
+        let gx = d1 * (p2.y - p0.y) as i128 - d2 * (p1.y - p0.y) as i128;
+        let gy = d2 * (p1.x - p0.x) as i128 - d1 * (p2.x - p0.x) as i128;
+        let (rx, ry) = (
+            256 * g.i_ref as i128 + 128 - p0.x as i128,
+            256 * g.j0 as i128 + 128 - p0.y as i128,
+        );
+        Plane {
+            row: (v[0] as i128 + div_round(gx * rx + gy * ry, g.area)) as i64,
+            sx: div_round(gx * 256, g.area) as i64,
+            sy: div_round(gy * 256, g.area) as i64,
+        }
+    }
+    #[inline(always)]
+    fn at(&self, di: i64) -> i64 {
+        self.row.wrapping_add(self.sx.wrapping_mul(di))
+    }
+    #[inline(always)]
+    fn next_row(&mut self) {
+        self.row = self.row.wrapping_add(self.sy);
+    }
+}
+
+/// A prepared triangle being walked row by row.
+struct Walk {
+    edges: [Edge; 3],
+    geom: Geom,
+    /// Vertex order after orientation.
+    #[cfg_attr(not(feature = "gouraud"), allow(dead_code))]
+    order: [usize; 3],
+    j1: i32,
+    t: Plane,
+    span: SpanCtx,
+}
+
+impl Walk {
+    /// The covered columns `[lo, hi)` of the current row inside `[0, width)`, if any.
+    #[inline(always)]
+    fn row(&self, width: u16) -> Option<(i32, i32)> {
+        let (mut lo, mut hi) = (0i64, width as i64);
+        for e in &self.edges {
+            let (l, h) = e.bound();
+            lo = lo.max(l);
+            hi = hi.min(h);
+        }
+        (lo < hi).then_some((lo as i32, hi as i32))
+    }
+    #[inline(always)]
+    fn next_row(&mut self) {
+        for e in &mut self.edges {
+            e.step();
+        }
+        self.t.next_row();
+    }
+}
+
+/// Per-triangle constants of the span loop: the `T` range drawn (far plane `2^F`, near plane) and `94 - F`.
 struct SpanCtx {
     t_lo: u64,
     t_hi: u64,
     shift_base: u32,
-    step_x: i64,
 }
 
 fn fill<D: DrawTarget>(
