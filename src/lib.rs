@@ -47,5 +47,5 @@ mod state;
 
 pub use depth::{DepthBuffer, DepthStore, W16_FAR};
 pub use error::Error;
-pub use raster::{Rasterizer, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS};
+pub use raster::{row_range, Rasterizer, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS};
 pub use state::{Compare, Cull, DepthRange, RenderState, MAX_T};

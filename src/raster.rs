@@ -107,6 +107,28 @@ fn t_of(rhw: f32, far: (u32, i32)) -> Result<(u64, i32), Error> {
     Ok((pm, pe))
 }
 
+/// Rows whose pixel centre lies in the snapped vertices' y-range (possibly empty: first > last).
+fn rows_of(p: &[Sub; 3]) -> (i32, i32) {
+    let ymin = p[0].y.min(p[1].y).min(p[2].y);
+    let ymax = p[0].y.max(p[1].y).max(p[2].y);
+    let first = (ymin as i64 - 128 + 255).div_euclid(256) as i32; // ceil((ymin - 128) / 256)
+    let last = (ymax as i64 - 128).div_euclid(256) as i32;
+    (first, last)
+}
+
+/// The frame rows `(first, last)` a triangle can cover (inclusive; empty when `first > last`), after snapping:
+/// for binning triangles into bands without setting them up. Errors as [`Rasterizer::draw`] for x and y.
+pub fn row_range<C>(v: &[Vertex<C>; 3]) -> Result<(i32, i32), Error> {
+    let mut p = [Sub { x: 0, y: 0 }; 3];
+    for (q, v) in p.iter_mut().zip(v) {
+        *q = Sub {
+            x: snap(v.x)?,
+            y: snap(v.y)?,
+        };
+    }
+    Ok(rows_of(&p))
+}
+
 /// Rounded `n / d` for `d > 0` (ties away from zero).
 fn div_round(n: i128, d: i128) -> i128 {
     if n >= 0 {
@@ -182,11 +204,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
         let p = order.map(|k| s.p[k]);
 
-        // Rows whose centre lies in the vertices' y-range, clipped to the buffer.
-        let ymin = p[0].y.min(p[1].y).min(p[2].y);
-        let ymax = p[0].y.max(p[1].y).max(p[2].y);
-        let j_first = (ymin as i64 - 128 + 255).div_euclid(256) as i32; // ceil((ymin - 128) / 256)
-        let j_last = (ymax as i64 - 128).div_euclid(256) as i32;
+        let (j_first, j_last) = rows_of(&p);
         let j0 = j_first.max(depth.y0());
         let j1 = j_last.min(depth.y0() + depth.height() as i32 - 1);
         if j0 > j1 {
