@@ -18,7 +18,10 @@ use embedded_graphics_core::primitives::Rectangle;
 use crate::depth::{encode_w16, DepthBuffer};
 use crate::edge::{Edge, Sub};
 use crate::fixed::{round_shift, split, to_fixed};
-use crate::recip::{DefaultRecip, PerPixel, SpanRecip};
+#[cfg(feature = "gouraud")]
+use crate::recip::Inv;
+use crate::recip::{normalise, DefaultRecip, PerPixel, SpanRecip, SpanWalker};
+use crate::state::Compare;
 use crate::state::{Cull, RenderState, MAX_T_LOG2};
 use crate::Error;
 #[cfg(feature = "gouraud")]
@@ -131,11 +134,56 @@ pub fn row_range<C>(v: &[Vertex<C>; 3]) -> Result<(i32, i32), Error> {
 
 /// Rounded `n / d` for `d > 0` (ties away from zero).
 fn div_round(n: i128, d: i128) -> i128 {
-    if n >= 0 {
-        (n + d / 2) / d
+    let (neg, a) = (n < 0, n.unsigned_abs() + (d as u128) / 2);
+    let q = div_u128(a, d as u128);
+    if neg {
+        -(q as i128)
     } else {
-        -((-n + d / 2) / d)
+        q as i128
     }
+}
+
+/// `floor(n / d)`. The plane solve divides numbers of up to ~90 bits by areas below 2^44; the generic `u128`
+/// division of 32-bit targets takes a 128-bit step per quotient bit (about 4,500 instructions a division on the
+/// Cortex-M4). When the quotient fits 64 bits (every triangle but extreme slivers) this walks the quotient bits with
+/// a 64-bit remainder (`r < 2d < 2^63`), the quotient shifting into `lo` as the dividend shifts out of it.
+fn div_u128(n: u128, d: u128) -> u128 {
+    let hi = (n >> 64) as u64;
+    if d >= 1 << 62 || hi as u128 >= d {
+        return n / d;
+    }
+    let mut lo = n as u64;
+    // With no high word, the leading zeros of `lo` give zero quotient bits: skip them.
+    let steps = if hi == 0 {
+        let z = lo.leading_zeros();
+        lo = lo.checked_shl(z).unwrap_or(0);
+        64 - z
+    } else {
+        64
+    };
+    if d < 1 << 31 {
+        // Small triangles: the remainder (< 2d) fits 32 bits.
+        let (d, mut r) = (d as u32, hi as u32);
+        for _ in 0..steps {
+            r = (r << 1) | (lo >> 63) as u32;
+            lo <<= 1;
+            if r >= d {
+                r -= d;
+                lo |= 1;
+            }
+        }
+    } else {
+        let (d, mut r) = (d as u64, hi);
+        for _ in 0..steps {
+            r = (r << 1) | (lo >> 63);
+            lo <<= 1;
+            if r >= d {
+                r -= d;
+                lo |= 1;
+            }
+        }
+    }
+    lo as u128
 }
 
 /// Draws triangles into a colour target and a W16 buffer, with reciprocal strategy `R`.
@@ -252,41 +300,32 @@ impl<R: SpanRecip> Rasterizer<R> {
             Err(stats) => return Ok(stats),
         };
         let color = v[0].color;
+        let (cmp, write) = (self.state.compare, self.state.depth_write);
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {
             if let Some((lo, hi)) = w.row(depth.width()) {
-                let mut t = w.t.at(lo as i64 - w.geom.i_ref) as u64;
-                let (cmp, write) = (self.state.compare, self.state.depth_write);
-                let row = depth.row_mut(j);
-                self.recip.begin_span(t, w.t.sx, (hi - lo) as u32);
-                let mut run_start = lo;
-                for i in lo..hi {
-                    let mut pass = false;
-                    if t >= w.span.t_lo && t <= w.span.t_hi {
-                        let inv = self.recip.recip(t);
-                        let code = encode_w16(inv.x, w.span.shift_base - inv.lz);
-                        let stored = &mut row[i as usize];
-                        if cmp.test(code, *stored) {
-                            if write {
-                                *stored = code;
-                            }
-                            pass = true;
-                        }
-                    }
-                    if !pass {
-                        if run_start < i {
-                            fill(target, run_start, i, j, color)?;
-                        }
-                        run_start = i + 1;
-                    } else {
-                        stats.written += 1;
-                    }
-                    t = t.wrapping_add(w.t.sx as u64);
-                }
-                if run_start < hi {
-                    fill(target, run_start, hi, j, color)?;
-                }
+                let t = w.t.at(lo as i64 - w.geom.i_ref) as u64;
+                let row = &mut depth.row_mut(j)[lo as usize..hi as usize];
+                let mut runs = Runs {
+                    target,
+                    lo,
+                    j,
+                    color,
+                    start: 0,
+                    fails: 0,
+                };
+                span(
+                    &mut self.recip,
+                    row,
+                    t,
+                    w.t.sx,
+                    &w.span,
+                    cmp,
+                    write,
+                    &mut runs,
+                )?;
                 stats.fragments += (hi - lo) as u32;
+                stats.written += (hi - lo) as u32 - runs.fails;
             }
             w.next_row();
         }
@@ -328,12 +367,16 @@ impl<R: SpanRecip> Rasterizer<R> {
                 let off = lo as i64 - w.geom.i_ref;
                 let mut t = w.t.at(off) as u64;
                 let mut q = planes.map(|p| p.at(off));
-                self.recip.begin_span(t, w.t.sx, (hi - lo) as u32);
+                self.recip.begin_span(false);
                 let (mut run_start, mut n) = (lo, 0usize);
                 for i in lo..hi {
                     let mut pass = false;
                     if t >= w.span.t_lo && t <= w.span.t_hi {
-                        let inv = self.recip.recip(t);
+                        let (m, lz) = normalise(t);
+                        let inv = Inv {
+                            x: self.recip.recip(m),
+                            lz,
+                        };
                         let code = encode_w16(inv.x, w.span.shift_base - inv.lz);
                         let stored = &mut row[i as usize];
                         if cmp.test(code, *stored) {
@@ -479,4 +522,192 @@ fn fill<D: DrawTarget>(
 ) -> Result<(), Error> {
     let r = Rectangle::new(Point::new(x0, y), Size::new((x1 - x0) as u32, 1));
     target.fill_solid(&r, color).map_err(|_| Error::Target)
+}
+
+/// The passing runs of a span, each sent to the target as one `fill_solid`; counts the failing pixels.
+struct Runs<'a, D: DrawTarget> {
+    target: &'a mut D,
+    lo: i32,
+    j: i32,
+    color: D::Color,
+    /// First pixel (span-relative) of the current run.
+    start: usize,
+    fails: u32,
+}
+
+impl<D: DrawTarget> Runs<'_, D> {
+    /// Pixel `k` failed: flush the run before it.
+    #[inline(always)]
+    fn fail(&mut self, k: usize) -> Result<(), Error> {
+        self.fails += 1;
+        let start = core::mem::replace(&mut self.start, k + 1);
+        if start < k {
+            fill(
+                self.target,
+                self.lo + start as i32,
+                self.lo + k as i32,
+                self.j,
+                self.color,
+            )?;
+        }
+        Ok(())
+    }
+    #[inline(always)]
+    fn finish(&mut self, n: usize) -> Result<(), Error> {
+        if self.start < n {
+            fill(
+                self.target,
+                self.lo + self.start as i32,
+                self.lo + n as i32,
+                self.j,
+                self.color,
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// W16 codes from `x` with a shift fixed while `lz` is: `round(65535 x / 2^sh)` as
+/// `(hi32(x * (65535 << k)) + 2^(s-1)) >> s`, `s = sh + k - 32`, `k = min(16, 63 - sh)`. Exactly the value of
+/// [`encode_w16`] (floor of a floor by a power of two), with one multiply, an add and a shift.
+struct W16Enc {
+    mul: u32,
+    round: u32,
+    s: u32,
+}
+
+impl W16Enc {
+    /// Largest reciprocal error for which no clamp is needed: `x` may exceed `1/t` by this, and at `t = 1` the code
+    /// `65535 (1 + e) + 1/2` still rounds down to 65535 while `65535 e < 1/2`.
+    const CLAMP_FREE: f64 = 0.5 / 65536.0;
+    /// `sh` is in `[30, 61]` on a span in range; anything else (after the step past a span's end) is kept harmless.
+    #[inline(always)]
+    fn new(sh: u32) -> Self {
+        let k = 16u32.min(63u32.saturating_sub(sh));
+        let s = (sh + k).saturating_sub(32).clamp(1, 31);
+        W16Enc {
+            mul: 65535 << k,
+            round: 1 << (s - 1),
+            s,
+        }
+    }
+    #[inline(always)]
+    fn code<R: SpanRecip>(&self, x: u32) -> u16 {
+        let hi = ((x as u64 * self.mul as u64) >> 32) as u32;
+        let c = (hi + self.round) >> self.s;
+        if R::MAX_REL_ERROR >= Self::CLAMP_FREE {
+            c.min(65535) as u16
+        } else {
+            debug_assert!(c <= 65535);
+            c as u16
+        }
+    }
+}
+
+/// One span: `row` is the depth buffer under it, `t` its first `T`, `dt` the step. Tame spans whose ends are both
+/// in range (so every pixel is) take the lean loop; the others check the range and normalise at every pixel.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn span<R: SpanRecip, D: DrawTarget>(
+    recip: &mut R,
+    row: &mut [u16],
+    t: u64,
+    dt: i64,
+    ctx: &SpanCtx,
+    cmp: Compare,
+    write: bool,
+    runs: &mut Runs<'_, D>,
+) -> Result<(), Error> {
+    let n = row.len();
+    let last = t.wrapping_add((dt as u64).wrapping_mul(n as u64 - 1));
+    let in_range = |v: u64| v >= ctx.t_lo && v <= ctx.t_hi;
+    let (tame, smooth) = SpanWalker::classify(t, dt, n as u32);
+    if tame && in_range(t) && in_range(last) {
+        recip.begin_span(smooth);
+        // The comparison is chosen once per span: the two common ones get their own loop, the rest share one.
+        match cmp {
+            Compare::Less => lean(recip, row, t, dt, ctx, |a, b| a < b, write, runs)?,
+            Compare::LessEqual => lean(recip, row, t, dt, ctx, |a, b| a <= b, write, runs)?,
+            _ => lean(recip, row, t, dt, ctx, |a, b| cmp.test(a, b), write, runs)?,
+        }
+    } else {
+        recip.begin_span(false);
+        let mut t = t;
+        for (k, stored) in row.iter_mut().enumerate() {
+            let mut pass = false;
+            if in_range(t) {
+                let (m, lz) = normalise(t);
+                let code = encode_w16(recip.recip(m), ctx.shift_base - lz);
+                if cmp.test(code, *stored) {
+                    if write {
+                        *stored = code;
+                    }
+                    pass = true;
+                }
+            }
+            if !pass {
+                runs.fail(k)?;
+            }
+            t = t.wrapping_add(dt as u64);
+        }
+    }
+    runs.finish(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The fast division equals `u128` division, on both of its paths and at their boundaries.
+    #[test]
+    fn div_u128_matches_u128_division() {
+        let mut s: u64 = 0x2545_F491_4F6C_DD1D;
+        let mut rnd = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        for k in 0..200_000 {
+            let d = (rnd() as u128 >> (rnd() % 64)).max(1) | if k % 7 == 0 { 1 << 62 } else { 0 };
+            let n = ((rnd() as u128) << 64 | rnd() as u128) >> (rnd() % 128);
+            assert_eq!(div_u128(n, d), n / d, "{n} / {d}");
+            let edge = (d << 64).saturating_sub(1 + (rnd() % 3) as u128);
+            assert_eq!(div_u128(edge, d), edge / d, "{edge} / {d}");
+        }
+        assert_eq!(div_round(-7, 2), -4);
+        assert_eq!(div_round(7, 2), 4);
+        assert_eq!(div_round(-5, 3), -2);
+    }
+}
+
+/// The lean loop of a tame span whose every pixel is in range: no range check, no leading-zero count.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn lean<R: SpanRecip, D: DrawTarget>(
+    recip: &mut R,
+    row: &mut [u16],
+    t: u64,
+    dt: i64,
+    ctx: &SpanCtx,
+    test: impl Fn(u16, u16) -> bool,
+    write: bool,
+    runs: &mut Runs<'_, D>,
+) -> Result<(), Error> {
+    let mut walk = SpanWalker::new(t, dt);
+    let mut enc = W16Enc::new(ctx.shift_base.wrapping_sub(walk.lz));
+    for (k, stored) in row.iter_mut().enumerate() {
+        let code = enc.code::<R>(recip.recip(walk.m()));
+        if test(code, *stored) {
+            if write {
+                *stored = code;
+            }
+        } else {
+            runs.fail(k)?;
+        }
+        if walk.step(recip) {
+            enc = W16Enc::new(ctx.shift_base.wrapping_sub(walk.lz));
+        }
+    }
+    Ok(())
 }

@@ -175,17 +175,17 @@ impl<S: Seed, const STEPS: usize> Recip32 for Newton<S, STEPS> {
 /// The default: piecewise-linear seed and one step (about 28 bits, two multiplies and a table read per pixel).
 pub type DefaultRecip = Newton<Lerp64, 1>;
 
-/// `1/t` for a pixel, `t = T / 2^32` (see [`SpanRecip`]): `1/t = x * 2^(lz - 62)`.
+/// `1/t` for a pixel, `t = T / 2^32`: `1/t = x * 2^(lz - 62)` (for tests and reports).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Inv {
     /// `1/d` in Q2.30, `d` the normalised mantissa of `T`.
     pub x: u32,
-    /// Leading zeros of `T` (`T >= 2^32` gives `lz <= 31`).
+    /// Leading zeros of `T`.
     pub lz: u32,
 }
 
 impl Inv {
-    /// `1/t` as f64 (for tests and reports).
+    /// `1/t` as f64.
     pub fn to_f64(self) -> f64 {
         self.x as f64 * libm_exp2(self.lz as i32 - 62)
     }
@@ -195,27 +195,40 @@ fn libm_exp2(e: i32) -> f64 {
     f64::from_bits(((1023 + e) as u64) << 52)
 }
 
+/// `T` normalised: its top 32 bits after shifting out the leading zeros, and their count (`T != 0`).
 #[inline(always)]
-fn normalise(t: u64) -> (u32, u32) {
+pub fn normalise(t: u64) -> (u32, u32) {
     let lz = t.leading_zeros();
     (((t << lz) >> 32) as u32, lz)
 }
 
-/// How a span gets `1/t` per pixel, where `t = W_far * RHW` is held as `T = t * 2^32` (see ARCHITECTURE.md).
-/// Normalising `T` to its top 32 bits truncates by less than `2^-31` relative; every bound below includes it.
+/// Truncating the normalised `T` to 32 bits (`2^-31`), and the drift of the [`SpanWalker`]: each upward
+/// renormalisation truncates its step by under one unit of `tt >= 2^63`, at most 32 of them per span (`T < 2^62`),
+/// each felt for fewer than `2^16` pixels (spans are `u16` wide), so below `2^-42` relative. One error, `2^-31 + 2^-42`.
+const MANTISSA_ERROR: f64 = 1.0 / (1u64 << 31) as f64 + 1.0 / (1u64 << 42) as f64;
+
+/// A span of pixels whose `T` changes by at most this fraction (`2^-SMOOTH_SHIFT`) of its smallest value per pixel
+/// is *smooth*: [`PrevPixel`] may chain along it.
+pub const SMOOTH_SHIFT: u32 = 11;
+
+/// How a span gets `1/d` per pixel for the normalised mantissa `m = d 2^32` of `T` (see ARCHITECTURE.md).
+/// The span walker hands over `m` pixel by pixel, and says when `T` crossed a power of two.
 pub trait SpanRecip: Default {
     /// Short name for reports.
     const NAME: &'static str;
     /// Largest relative error of `1/t` at any pixel (derived; a test sweeps spans and asserts it).
     const MAX_REL_ERROR: f64;
-    /// Called before the first pixel of a span with `T` there, its step per pixel and the pixel count (>= 1).
+    /// Before the first pixel of a span; `smooth` as defined at [`SMOOTH_SHIFT`].
     #[inline(always)]
-    fn begin_span(&mut self, _t: u64, _dt: i64, _len: u32) {}
-    /// `1/t` for the next pixel of the span (`2^32 <= t < 2^57`).
-    fn recip(&mut self, t: u64) -> Inv;
+    fn begin_span(&mut self, _smooth: bool) {}
+    /// `1/d` in Q2.30 for the next pixel of the span (`m >= 2^31`).
+    fn recip(&mut self, m: u32) -> u32;
+    /// `T` crossed a power of two since the previous pixel (`up`: upward), so `m` was renormalised by a factor 2.
+    #[inline(always)]
+    fn rebase(&mut self, _up: bool) {}
 }
 
-/// Every pixel on its own: normalise (count leading zeros) and run `R`.
+/// Every pixel on its own: run `R` on the pixel's mantissa.
 pub struct PerPixel<R>(PhantomData<R>);
 
 impl<R> Default for PerPixel<R> {
@@ -226,40 +239,35 @@ impl<R> Default for PerPixel<R> {
 
 impl<R: Recip32> SpanRecip for PerPixel<R> {
     const NAME: &'static str = R::NAME;
-    const MAX_REL_ERROR: f64 = R::MAX_REL_ERROR + 1.0 / (1u64 << 31) as f64;
+    const MAX_REL_ERROR: f64 = R::MAX_REL_ERROR + MANTISSA_ERROR;
     #[inline(always)]
-    fn recip(&mut self, t: u64) -> Inv {
-        let (m, lz) = normalise(t);
-        Inv { x: R::recip(m), lz }
+    fn recip(&mut self, m: u32) -> u32 {
+        R::recip(m)
     }
 }
 
 /// Seeded from the previous pixel of the span: one Newton-Raphson step, no table, no normalisation of the seed.
 ///
 /// The seed's relative error is the relative change of `t` from the previous pixel plus that pixel's error.
-/// A span uses it only when `|dt| <= t_min / 2^11` over the whole span (checked at `begin_span`, from the span's two
-/// ends, since `t` is linear along it); other spans, and the first pixel of every span, take the full
-/// [`DefaultRecip`]. With `delta <= 2^-11` the error stays below `(2^-11 + e)^2 + 2^-29`, whose fixed point
-/// is below `2^-22 + 2^-29` (checked by the const below and by the span sweep in the tests).
+/// It chains only along smooth spans (`|dt| <= t_min / 2^11`, [`SMOOTH_SHIFT`]); other spans, and the first pixel of
+/// every span, take the full [`DefaultRecip`]. With `delta <= 2^-11` the error stays below `(2^-11 + e)^2 + 2^-29`
+/// (plus the mantissa's own truncation), whose fixed point is below `2^-22 + 2^-29` (the const below iterates it;
+/// the span sweep in the tests checks it).
 #[derive(Default)]
 pub struct PrevPixel {
     x: u32,
-    lz: u32,
     /// The span qualifies for chaining.
     smooth: bool,
     /// A previous pixel of this span exists.
     chain: bool,
 }
 
-const PREV_SHIFT: u32 = 11;
-
 const fn prev_fixed_point() -> f64 {
-    let d = 1.0 / (1u64 << PREV_SHIFT) as f64;
+    let d = 1.0 / (1u64 << SMOOTH_SHIFT) as f64;
     let mut e = PerPixel::<DefaultRecip>::MAX_REL_ERROR;
     let mut i = 0;
     while i < 64 {
-        // the 2^-31 of normalising the new T enters the error of its exact reciprocal, as in PerPixel
-        let n = (d + e) * (d + e) + 2.0 / (1u64 << 30) as f64 + 1.0 / (1u64 << 31) as f64;
+        let n = (d + e) * (d + e) + 2.0 / (1u64 << 30) as f64 + MANTISSA_ERROR;
         e = if n > e { n } else { e };
         i += 1;
     }
@@ -269,33 +277,90 @@ const fn prev_fixed_point() -> f64 {
 impl SpanRecip for PrevPixel {
     const NAME: &'static str = "prev-pixel";
     const MAX_REL_ERROR: f64 = prev_fixed_point();
-    #[inline]
-    fn begin_span(&mut self, t: u64, dt: i64, len: u32) {
-        let last = t.wrapping_add((dt as u64).wrapping_mul(len as u64 - 1));
-        let tmin = if dt < 0 { last } else { t };
+    #[inline(always)]
+    fn begin_span(&mut self, smooth: bool) {
+        self.smooth = smooth;
         self.chain = false;
-        // Chain only when every step is small against the smallest t of the span.
-        self.smooth = dt.unsigned_abs() <= (tmin >> PREV_SHIFT) && tmin >= 1 << 32;
     }
-    #[inline]
-    fn recip(&mut self, t: u64) -> Inv {
-        let (m, lz) = normalise(t);
-        if self.chain {
-            // Re-express the previous 1/d for this pixel's binade: one binade down in t doubles 1/d's scale.
-            let seed = if lz == self.lz {
-                self.x
-            } else if lz > self.lz {
-                self.x >> 1
-            } else {
-                self.x << 1
-            };
-            self.x = newton_step(m, seed);
+    #[inline(always)]
+    fn recip(&mut self, m: u32) -> u32 {
+        self.x = if self.chain {
+            newton_step(m, self.x)
         } else {
             self.chain = self.smooth;
-            self.x = DefaultRecip::recip(m);
+            DefaultRecip::recip(m)
+        };
+        self.x
+    }
+    #[inline(always)]
+    fn rebase(&mut self, up: bool) {
+        // One binade up in T halves the mantissa's d, doubling 1/d (x < 2^31 here since d was near 1); down halves it.
+        self.x = if up { self.x << 1 } else { self.x >> 1 };
+    }
+}
+
+/// `T` along a span, pre-normalised so the loop never counts leading zeros: `tt = T << lz` keeps its top bit set
+/// and is stepped by `st = dt << lz`; the mantissa is the high word. When `T` crosses a power of two, `tt` and `st`
+/// are shifted by one (the rare branch) and the reciprocal is told. Only for *tame* spans: every `T` on the span in
+/// `[2^30, 2^62)` and `|dt| <= T_min / 4`, so `|st| <= tt / 4` always and a step crosses at most one power of two.
+pub struct SpanWalker {
+    tt: u64,
+    st: i64,
+    /// Leading zeros of the current `T`.
+    pub lz: u32,
+}
+
+impl SpanWalker {
+    /// Whether a span from `t0` with step `dt` over `len >= 1` pixels is tame, and whether it is smooth
+    /// ([`SMOOTH_SHIFT`]). `t0` and the last `T` must already be known to lie in `[2^30, 2^62)`.
+    #[inline]
+    pub fn classify(t0: u64, dt: i64, len: u32) -> (bool, bool) {
+        let last = t0.wrapping_add((dt as u64).wrapping_mul(len as u64 - 1));
+        let tmin = t0.min(last);
+        let a = dt.unsigned_abs();
+        (a <= tmin >> 2, a <= tmin >> SMOOTH_SHIFT)
+    }
+    /// Starts at `t0` (a tame span, see [`SpanWalker::classify`]).
+    #[inline(always)]
+    pub fn new(t0: u64, dt: i64) -> Self {
+        let lz = t0.leading_zeros();
+        SpanWalker {
+            tt: t0 << lz,
+            st: dt << lz,
+            lz,
         }
-        self.lz = lz;
-        Inv { x: self.x, lz }
+    }
+    /// The normalised mantissa of the current `T`.
+    #[inline(always)]
+    pub fn m(&self) -> u32 {
+        (self.tt >> 32) as u32
+    }
+    /// Moves to the next pixel; `true` when `lz` changed (then `r` has been told).
+    #[inline(always)]
+    pub fn step<R: SpanRecip>(&mut self, r: &mut R) -> bool {
+        self.tt = self.tt.wrapping_add(self.st as u64);
+        if self.tt >> 63 == 0 {
+            self.renormalise(r);
+            true
+        } else {
+            false
+        }
+    }
+    #[cold]
+    fn renormalise<R: SpanRecip>(&mut self, r: &mut R) {
+        let up = self.st > 0;
+        if up {
+            // T + dt overflowed 2^64 (|st| <= tt/4 keeps it below 1.25 * 2^64): put the carry back as the top bit.
+            self.tt = (self.tt >> 1) | (1 << 63);
+            self.st >>= 1;
+            self.lz = self.lz.wrapping_sub(1);
+        } else {
+            // T fell below 2^63 but stays above 0.75 * 2^63.
+            self.tt <<= 1;
+            self.st <<= 1;
+            self.lz = self.lz.wrapping_add(1);
+        }
+        r.rebase(up);
     }
 }
 
@@ -373,13 +438,11 @@ mod tests {
         assert_bound::<Newton<Lerp64, 1>>(28.0);
     }
 
-    /// Spans of every slope the previous-pixel seed accepts, and the steeper ones it must refuse, across binades:
-    /// the error at every pixel stays within the stated bound, relative to the exact `2^32 / T`.
-    #[test]
-    fn prev_pixel_bound_holds_along_spans() {
-        let mut worst = 0.0f64;
-        let mut pixels = 0u64;
-        let mut chained_spans = 0;
+    /// Random spans across binades, of every slope the span walker accepts and the previous-pixel seed chains on,
+    /// and steeper ones it must not chain on: the error at every pixel stays within the stated bound, relative to
+    /// the exact `2^32 / T` (T from exact integer arithmetic, not from the walker).
+    fn spans<R: SpanRecip>() -> (f64, u64, usize) {
+        let (mut worst, mut pixels, mut smooth_spans) = (0.0f64, 0u64, 0);
         let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
         let mut rnd = move || {
             state ^= state << 13;
@@ -387,30 +450,51 @@ mod tests {
             state ^= state << 17;
             state
         };
-        for _ in 0..4000 {
-            let t0 = (1u64 << 32) + rnd() % (1u64 << 50);
+        for _ in 0..6000 {
+            let t0 = (1u64 << 30) + rnd() % (1u64 << (31 + rnd() % 31));
             let len = 1 + (rnd() % 400) as u32;
-            // slopes from tiny to 4x the acceptance limit, both signs
-            let lim = (t0 >> PREV_SHIFT) as i64;
-            let dt = ((rnd() % (4 * lim as u64 + 1)) as i64 - 2 * lim) / (1 + (rnd() % 64) as i64);
+            let lim = (t0 >> 2) as i64;
+            let dt = ((rnd() % (2 * lim as u64 + 1)) as i64 - lim) >> (rnd() % 20);
             let end = t0 as i128 + dt as i128 * (len as i128 - 1);
-            if !((1i128 << 32)..(1i128 << 57)).contains(&end) {
+            if !((1i128 << 30)..(1i128 << 62)).contains(&end) {
                 continue;
             }
-            let mut r = PrevPixel::default();
-            r.begin_span(t0, dt, len);
-            chained_spans += usize::from(r.smooth);
-            let mut t = t0;
-            for _ in 0..len {
-                let inv = r.recip(t);
-                let exact = (1u64 << 32) as f64 / t as f64;
-                worst = worst.max((inv.to_f64() / exact - 1.0).abs());
+            let (tame, smooth) = SpanWalker::classify(t0, dt, len);
+            if !tame {
+                continue;
+            }
+            smooth_spans += usize::from(smooth);
+            let mut r = R::default();
+            r.begin_span(smooth);
+            let mut w = SpanWalker::new(t0, dt);
+            for k in 0..len as i128 {
+                let inv = Inv {
+                    x: r.recip(w.m()),
+                    lz: w.lz,
+                };
+                let t = (t0 as i128 + dt as i128 * k) as f64;
+                worst = worst.max((inv.to_f64() * t / (1u64 << 32) as f64 - 1.0).abs());
                 pixels += 1;
-                t = t.wrapping_add(dt as u64);
+                w.step(&mut r);
             }
         }
-        std::println!("prev-pixel: {pixels} pixels, {chained_spans} chained spans, worst {worst:e}, bound {:e}", PrevPixel::MAX_REL_ERROR);
-        assert!(chained_spans > 500, "the sweep must exercise chaining");
+        (worst, pixels, smooth_spans)
+    }
+
+    #[test]
+    fn span_walker_and_reciprocals_hold_their_bounds_along_spans() {
+        let (worst, pixels, smooth) = spans::<PrevPixel>();
+        std::println!(
+            "prev-pixel: {pixels} pixels, {smooth} smooth spans, worst {worst:e}, bound {:e}",
+            PrevPixel::MAX_REL_ERROR
+        );
+        assert!(smooth > 1000, "the sweep must exercise chaining");
         assert!(worst <= PrevPixel::MAX_REL_ERROR);
+        let (worst, pixels, _) = spans::<PerPixel<DefaultRecip>>();
+        std::println!(
+            "per-pixel: {pixels} pixels, worst {worst:e}, bound {:e}",
+            PerPixel::<DefaultRecip>::MAX_REL_ERROR
+        );
+        assert!(worst <= PerPixel::<DefaultRecip>::MAX_REL_ERROR);
     }
 }

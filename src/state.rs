@@ -64,11 +64,12 @@ pub enum Cull {
 pub struct DepthRange {
     near: f32,
     far: f32,
-    /// `far / near = ratio_m / ratio_d * 2^ratio_e`, exactly (both mantissas of the f32s).
-    ratio_m: u64,
-    ratio_d: u64,
-    ratio_e: i32,
+    /// `floor(far / near * 2^TMAX_FRAC)`, so that `t_max(frac)` is a shift (a floor of a floor by a power of two).
+    t_max_q: u128,
 }
+
+/// Fraction bits of [`DepthRange`]'s stored `far / near`: at least the largest `frac` a triangle uses (61).
+const TMAX_FRAC: u32 = 64;
 
 impl DepthRange {
     /// Checks and stores the range.
@@ -89,12 +90,18 @@ impl DepthRange {
         if !ok {
             return Err(Error::InvalidDepthRange);
         }
+        // far/near = mf / mn * 2^(ef - en) exactly (the f32 mantissas); it is below 2^31, so the quotient is below 2^95.
+        let (ratio_m, ratio_d, ratio_e) = (mf as u64, mn as u64, ef - en);
+        let e = ratio_e + TMAX_FRAC as i32;
+        let t_max_q = if e >= 0 {
+            ((ratio_m as u128) << e) / ratio_d as u128
+        } else {
+            ((ratio_m as u128) >> (-e).min(127)) / ratio_d as u128
+        };
         Ok(DepthRange {
             near: w_near,
             far: w_far,
-            ratio_m: mf as u64,
-            ratio_d: mn as u64,
-            ratio_e: ef - en,
+            t_max_q,
         })
     }
     /// `W_near`.
@@ -107,13 +114,7 @@ impl DepthRange {
     }
     /// `floor(far / near * 2^frac)`: the largest `T = t * 2^frac` still at or beyond the near plane.
     pub(crate) fn t_max(&self, frac: u32) -> u64 {
-        let e = self.ratio_e + frac as i32;
-        let num = self.ratio_m as u128;
-        let q = if e >= 0 {
-            (num << e) / self.ratio_d as u128
-        } else {
-            (num >> (-e).min(127)) / self.ratio_d as u128
-        };
+        let q = self.t_max_q >> (TMAX_FRAC - frac.min(TMAX_FRAC));
         q.min(u64::MAX as u128) as u64
     }
 }

@@ -1,0 +1,307 @@
+//! What every wraster firmware shares: the standard scenes baked into flash (from `wraster::scenes`, by build.rs),
+//! rendering them band by band with triangles binned by rows, the frame hash, and the `bench` line.
+//!
+//! Hash: FNV-1a 64 over the frame's rows in order; for each row the colour of every pixel (RGB565, u16 little-endian)
+//! then the depth of every pixel (W16, u16 little-endian). The host computes the same (host-tests/tests/firmware.rs).
+#![no_std]
+#![forbid(unsafe_code)]
+
+use core::fmt::Write;
+
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::geometry::{OriginDimensions, Size};
+use embedded_graphics_core::pixelcolor::raw::RawU16;
+use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
+use embedded_graphics_core::primitives::Rectangle;
+use embedded_graphics_core::Pixel;
+use wraster::recip::SpanRecip;
+use wraster::{DepthBuffer, Error, Rasterizer, RenderState, Stats, Vertex};
+
+/// A baked triangle: `(x, y, rhw)` bit patterns per vertex, the RGB565 colour, the rows it can cover.
+pub struct Tri {
+    /// Vertices as f32 bit patterns.
+    pub v: [[u32; 3]; 3],
+    /// RGB565.
+    pub color: u16,
+    /// First and last row (inclusive) from `wraster::row_range`.
+    pub rows: (i32, i32),
+}
+
+/// A baked scene.
+pub struct SceneData {
+    /// Name, as printed.
+    pub name: &'static str,
+    /// `W_near`.
+    pub near: f32,
+    /// `W_far`.
+    pub far: f32,
+    /// Triangles in drawing order.
+    pub tris: &'static [Tri],
+}
+
+include!(concat!(env!("OUT_DIR"), "/scenes.rs"));
+
+/// Frame size of the standard scenes.
+pub const WIDTH: u16 = 320;
+/// Frame size of the standard scenes.
+pub const HEIGHT: u16 = 240;
+
+impl Tri {
+    /// The vertices.
+    #[inline]
+    pub fn vertices(&self) -> [Vertex<Rgb565>; 3] {
+        let c = Rgb565::from(RawU16::new(self.color));
+        self.v.map(|[x, y, rhw]| Vertex {
+            x: f32::from_bits(x),
+            y: f32::from_bits(y),
+            z: 0.0,
+            rhw: f32::from_bits(rhw),
+            color: c,
+        })
+    }
+}
+
+/// A colour band: rows `[y0, y0 + h)` of a `WIDTH`-wide frame. Writes outside it are dropped (never out of bounds).
+pub struct Band<'a> {
+    px: &'a mut [u16],
+    y0: i32,
+    h: i32,
+}
+
+impl<'a> Band<'a> {
+    /// `px.len()` must be `WIDTH * h`.
+    pub fn new(px: &'a mut [u16], y0: i32) -> Self {
+        let h = (px.len() / WIDTH as usize) as i32;
+        Band { px, y0, h }
+    }
+}
+
+impl OriginDimensions for Band<'_> {
+    fn size(&self) -> Size {
+        Size::new(WIDTH as u32, (self.y0 + self.h) as u32)
+    }
+}
+
+impl DrawTarget for Band<'_> {
+    type Color = Rgb565;
+    type Error = core::convert::Infallible;
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(
+        &mut self,
+        pixels: I,
+    ) -> Result<(), Self::Error> {
+        for Pixel(p, c) in pixels {
+            let r = p.y - self.y0;
+            if (0..self.h).contains(&r) && (0..WIDTH as i32).contains(&p.x) {
+                self.px[r as usize * WIDTH as usize + p.x as usize] = c.into_storage();
+            }
+        }
+        Ok(())
+    }
+    #[inline]
+    fn fill_solid(&mut self, area: &Rectangle, c: Rgb565) -> Result<(), Self::Error> {
+        let v = c.into_storage();
+        let x0 = area.top_left.x.max(0) as usize;
+        let x1 = ((area.top_left.x + area.size.width as i32).min(WIDTH as i32)).max(0) as usize;
+        for y in area.top_left.y..area.top_left.y + area.size.height as i32 {
+            let r = y - self.y0;
+            if (0..self.h).contains(&r) && x0 < x1 {
+                let base = r as usize * WIDTH as usize;
+                self.px[base + x0..base + x1].fill(v);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// FNV-1a 64.
+pub struct Fnv(pub u64);
+
+impl Default for Fnv {
+    fn default() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv {
+    /// Hashes the little-endian bytes of `words`.
+    pub fn words(&mut self, words: &[u16]) {
+        for w in words {
+            for b in w.to_le_bytes() {
+                self.0 ^= b as u64;
+                self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        }
+    }
+}
+
+/// A counter that counts nothing (for boards that only draw).
+pub struct NoCounter;
+
+impl Counter for NoCounter {
+    fn start(&mut self) {}
+    fn stop(&mut self) -> u64 {
+        0
+    }
+}
+
+/// Counts instructions (never cycles) between `start` and `stop`.
+pub trait Counter {
+    /// Starts or resumes.
+    fn start(&mut self);
+    /// Instructions since the matching `start`.
+    fn stop(&mut self) -> u64;
+}
+
+/// Instructions counted with SysTick on the core clock, under QEMU's `-icount shift=0` (one instruction per virtual
+/// nanosecond): `ticks * num / den` instructions (25 MHz mps2: 40/1; 16 MHz microbit: 125/2). Resolution: one tick
+/// per `start`/`stop` pair. A wrap of the 24-bit counter between them is refused (a panic, so a non-zero exit).
+#[cfg(feature = "systick")]
+pub struct SysTick {
+    syst: cortex_m::peripheral::SYST,
+    num: u64,
+    den: u64,
+}
+
+#[cfg(feature = "systick")]
+impl SysTick {
+    /// Takes the SysTick peripheral; `num / den` instructions per tick.
+    pub fn new(mut syst: cortex_m::peripheral::SYST, num: u64, den: u64) -> Self {
+        syst.set_clock_source(cortex_m::peripheral::syst::SystClkSource::Core);
+        syst.set_reload(0x00ff_ffff);
+        SysTick { syst, num, den }
+    }
+}
+
+#[cfg(feature = "systick")]
+impl Counter for SysTick {
+    fn start(&mut self) {
+        self.syst.clear_current();
+        let _ = self.syst.has_wrapped(); // reading COUNTFLAG clears it
+        self.syst.enable_counter();
+    }
+    fn stop(&mut self) -> u64 {
+        let now = cortex_m::peripheral::SYST::get_current();
+        self.syst.disable_counter();
+        assert!(
+            !self.syst.has_wrapped(),
+            "SysTick wrapped between start and stop"
+        );
+        // After the clear the counter reads 0 until the first tick reloads it with 0xff_ffff.
+        let ticks = if now == 0 {
+            0
+        } else {
+            0x0100_0000 - now as u64
+        };
+        ticks * self.num / self.den
+    }
+}
+
+/// What one scene run measured.
+pub struct Run {
+    /// Scene name.
+    pub scene: &'static str,
+    /// Reciprocal strategy (`SpanRecip::NAME`).
+    pub recip: &'static str,
+    /// Summed draw statistics.
+    pub stats: Stats,
+    /// Bands drawn.
+    pub bands: u32,
+    /// Triangles in the scene.
+    pub triangles: u32,
+    /// Instructions spent in draw calls (not clears, hashing or printing).
+    pub instructions: u64,
+    /// Frame hash.
+    pub hash: u64,
+}
+
+/// Renders `scene` band by band with the given buffers (`color.len() == depth.len() == WIDTH * band rows`).
+/// Each band clears its buffers, then draws only the triangles whose row range meets it (binning).
+/// `R` is the reciprocal strategy (`wraster::recip`).
+pub fn run_scene<R: SpanRecip, C: Counter>(
+    scene: &SceneData,
+    color: &mut [u16],
+    depth: &mut [u16],
+    counter: &mut C,
+) -> Result<Run, Error> {
+    run_scene_with::<R, C>(scene, color, depth, counter, |_, _| {})
+}
+
+/// [`run_scene`], handing each finished band (first row, RGB565 pixels, `WIDTH` per row) to `on_band`: a display
+/// driver pushes it out there.
+pub fn run_scene_with<R: SpanRecip, C: Counter>(
+    scene: &SceneData,
+    color: &mut [u16],
+    depth: &mut [u16],
+    counter: &mut C,
+    mut on_band: impl FnMut(u16, &[u16]),
+) -> Result<Run, Error> {
+    let band_h = (depth.len() / WIDTH as usize) as u16;
+    let mut r = Rasterizer::<R>::new(RenderState::new(scene.near, scene.far)?);
+    let mut stats = Stats::default();
+    let (mut instructions, mut hash, mut bands) = (0u64, Fnv::default(), 0u32);
+    let mut y0 = 0u16;
+    while y0 < HEIGHT {
+        let h = band_h.min(HEIGHT - y0);
+        let n = WIDTH as usize * h as usize;
+        let (color, depth) = (&mut color[..n], &mut depth[..n]);
+        color.fill(0);
+        let mut buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+        buf.clear();
+        let mut band = Band::new(color, y0 as i32);
+        let (b0, b1) = (y0 as i32, (y0 + h) as i32 - 1);
+        counter.start();
+        for t in scene.tris {
+            if t.rows.0 <= b1 && t.rows.1 >= b0 {
+                stats += r.draw(&mut band, &mut buf, &t.vertices())?;
+            }
+        }
+        instructions += counter.stop();
+        let w = WIDTH as usize;
+        for row in 0..h as usize {
+            hash.words(&band.px[row * w..(row + 1) * w]);
+            hash.words(&buf.data()[row * w..(row + 1) * w]);
+        }
+        on_band(y0, band.px);
+        bands += 1;
+        y0 += h;
+    }
+    Ok(Run {
+        scene: scene.name,
+        recip: R::NAME,
+        stats,
+        bands,
+        triangles: scene.tris.len() as u32,
+        instructions,
+        hash: hash.0,
+    })
+}
+
+/// `num / den` with one decimal, by integers.
+struct Ratio(u64, u64);
+
+impl core::fmt::Display for Ratio {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let tenths = (self.0 * 10 + self.1 / 2) / self.1.max(1);
+        write!(f, "{}.{}", tenths / 10, tenths % 10)
+    }
+}
+
+/// The bench line of a run (the format; keys are stable).
+pub fn bench_line(board: &str, core: &str, run: &Run) -> heapless::String<320> {
+    let mut s = heapless::String::new();
+    let (px, fr) = (run.stats.written as u64, run.stats.fragments as u64);
+    let _ = write!(
+        s,
+        "bench board={board} core={core} scene={} format=W16 bands={} pixels={px} fragments={fr} triangles={} instructions={} instr_per_px={} instr_per_fragment={} instr_per_tri={} hash={:016x} recip={}",
+        run.scene,
+        run.bands,
+        run.triangles,
+        run.instructions,
+        Ratio(run.instructions, px),
+        Ratio(run.instructions, fr),
+        Ratio(run.instructions, run.triangles as u64),
+        run.hash,
+        run.recip
+    );
+    s
+}

@@ -1,0 +1,55 @@
+//! wraster on QEMU `microbit` (nRF51, Cortex-M0, 16 KiB RAM, thumbv6m-none-eabi), memory map in `memory.x`.
+//!
+//! The frame does not fit in RAM: every standard scene is rendered in 30 bands of 8 rows (a 320x8 colour band and
+//! a 320x8 W16 band, 10 KiB), triangles binned by rows (see `wraster-board`), with the default reciprocal and with the previous-pixel seed, prints one `bench` line per
+//! run over semihosting and exits 0; any error or panic exits non-zero.
+//! Run: `cd boards/qemu-m0 && cargo run --release` (the runner in `.cargo/config.toml` adds `-icount shift=0`).
+//!
+//! Instructions are counted with SysTick on the 16 MHz core clock: one tick is exactly 62.5 instructions under
+//! `-icount shift=0`, read around the draw calls only (not the clears, the hash or the printing).
+//! These are instructions, not cycles: QEMU is not cycle-accurate.
+#![no_std]
+#![no_main]
+
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use panic_semihosting as _;
+use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
+use wraster_board::{bench_line, run_scene, SysTick, HEIGHT, SCENES, WIDTH};
+
+/// Rows per band: the largest multiple of 8 whose two buffers leave room for the stack in 16 KiB.
+const BAND_ROWS: usize = 8;
+const PIXELS: usize = WIDTH as usize * BAND_ROWS;
+const _: () = assert!((HEIGHT as usize).is_multiple_of(BAND_ROWS));
+
+fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
+    let mut ok = true;
+    for scene in &SCENES {
+        match run_scene::<R, _>(scene, color, depth, counter) {
+            Ok(run) => hprintln!("{}", bench_line("qemu-m0", "m0", &run)),
+            Err(e) => {
+                hprintln!("error board=qemu-m0 scene={} {}", scene.name, e);
+                ok = false;
+            }
+        }
+    }
+    ok
+}
+
+#[entry]
+fn main() -> ! {
+    static mut COLOR: [u16; PIXELS] = [0; PIXELS];
+    static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
+    let cp = cortex_m::Peripherals::take().unwrap();
+    let mut counter = SysTick::new(cp.SYST, 125, 2);
+    let ok = all::<PerPixel<DefaultRecip>>(COLOR, DEPTH, &mut counter)
+        & all::<PrevPixel>(COLOR, DEPTH, &mut counter);
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    loop {
+        cortex_m::asm::wfi();
+    }
+}

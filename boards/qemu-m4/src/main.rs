@@ -1,0 +1,52 @@
+//! wraster on QEMU `mps2-an386` (Cortex-M4F, thumbv7em-none-eabihf), memory map from the top-level `memory.x`.
+//!
+//! Renders every standard scene (`wraster::scenes`, baked by `wraster-board`) whole-frame (320x240 colour and W16
+//! depth in RAM, one band), with the default reciprocal and with the previous-pixel seed, prints one `bench` line per
+//! run over semihosting and exits 0; any error or panic exits non-zero.
+//! Run: `cd boards/qemu-m4 && cargo run --release` (the runner in `.cargo/config.toml` adds `-icount shift=0`).
+//!
+//! Instructions are counted with SysTick on the 25 MHz core clock: one tick is exactly 40 instructions under
+//! `-icount shift=0`, read around the draw calls only (not the clears, the hash or the printing).
+//! These are instructions, not cycles: QEMU is not cycle-accurate.
+#![no_std]
+#![no_main]
+
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use panic_semihosting as _;
+use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
+use wraster_board::{bench_line, run_scene, SysTick, HEIGHT, SCENES, WIDTH};
+
+const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
+
+fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
+    let mut ok = true;
+    for scene in &SCENES {
+        match run_scene::<R, _>(scene, color, depth, counter) {
+            Ok(run) => hprintln!("{}", bench_line("qemu-m4", "m4", &run)),
+            Err(e) => {
+                hprintln!("error board=qemu-m4 scene={} {}", scene.name, e);
+                ok = false;
+            }
+        }
+    }
+    ok
+}
+
+#[entry]
+fn main() -> ! {
+    static mut COLOR: [u16; PIXELS] = [0; PIXELS];
+    static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
+    let cp = cortex_m::Peripherals::take().unwrap();
+    let mut counter = SysTick::new(cp.SYST, 40, 1);
+    let ok = all::<PerPixel<DefaultRecip>>(COLOR, DEPTH, &mut counter)
+        & all::<PrevPixel>(COLOR, DEPTH, &mut counter);
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    loop {
+        cortex_m::asm::wfi();
+    }
+}

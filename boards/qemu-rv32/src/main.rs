@@ -1,0 +1,67 @@
+//! wraster on QEMU `virt` (RV32IMAC, riscv32imac-unknown-none-elf), memory map in `memory.x`.
+//!
+//! Renders every standard scene whole-frame (320x240 colour and W16 depth in RAM), with the default reciprocal and
+//! with the previous-pixel seed, prints one `bench` line per run over semihosting and exits 0; any error or panic
+//! exits non-zero. Run: `cd boards/qemu-rv32 && cargo run --release`.
+//!
+//! Instructions are the difference of the `minstret` CSR (instructions retired) around the draw calls only: exact.
+#![no_std]
+#![no_main]
+#![forbid(unsafe_code)]
+
+use riscv_rt::entry;
+use riscv_semihosting::{debug, hprintln};
+use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
+use wraster_board::{bench_line, run_scene, Counter, HEIGHT, SCENES, WIDTH};
+
+const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
+
+struct Minstret(u64);
+
+impl Counter for Minstret {
+    fn start(&mut self) {
+        self.0 = riscv::register::minstret::read64();
+    }
+    fn stop(&mut self) -> u64 {
+        riscv::register::minstret::read64() - self.0
+    }
+}
+
+fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16]) -> bool {
+    let mut ok = true;
+    for scene in &SCENES {
+        match run_scene::<R, _>(scene, color, depth, &mut Minstret(0)) {
+            Ok(run) => hprintln!("{}", bench_line("qemu-rv32", "rv32", &run)),
+            Err(e) => {
+                hprintln!("error board=qemu-rv32 scene={} {}", scene.name, e);
+                ok = false;
+            }
+        }
+    }
+    ok
+}
+
+#[entry]
+fn main() -> ! {
+    // The frame lives on the stack (riscv-rt gives it the top of the 16 MiB RAM): no `static mut`, no unsafe.
+    let (mut color, mut depth) = ([0u16; PIXELS], [0u16; PIXELS]);
+    let ok = all::<PerPixel<DefaultRecip>>(&mut color, &mut depth)
+        & all::<PrevPixel>(&mut color, &mut depth);
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    loop {
+        riscv::asm::wfi();
+    }
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    hprintln!("panic: {}", info);
+    debug::exit(debug::EXIT_FAILURE);
+    loop {
+        riscv::asm::wfi();
+    }
+}

@@ -1,0 +1,34 @@
+#!/usr/bin/env python3
+"""Instruction-level profile of a board run: `profile.py ELF COUNTS [N]` joins insncount's per-PC counts with the
+disassembly (llvm-objdump) and prints per-function totals and the N hottest instructions. Instructions, not cycles."""
+import re, subprocess, sys, glob, os
+
+elf, counts = sys.argv[1], sys.argv[2]
+top = int(sys.argv[3]) if len(sys.argv) > 3 else 60
+tools = glob.glob(os.path.expanduser('~/.rustup/toolchains/*/lib/rustlib/*/bin/llvm-objdump'))
+objdump = tools[0] if tools else 'llvm-objdump'
+dis, func, cur = {}, {}, '?'
+for line in subprocess.run([objdump, '-d', '-C', '--no-show-raw-insn', elf], capture_output=True, text=True).stdout.splitlines():
+    m = re.match(r'^[0-9a-f]+ <(.*)>:', line)
+    if m:
+        cur = m.group(1)
+        continue
+    m = re.match(r'\s*([0-9a-f]+):\s+(.*)', line)
+    if m:
+        a = int(m.group(1), 16)
+        dis[a], func[a] = m.group(2).split('@')[0].strip(), cur
+cnt = {}
+for line in open(counts):
+    a, c = line.split()
+    cnt[int(a, 16)] = int(c)
+total = sum(cnt.values())
+print(f'total {total} instructions')
+per = {}
+for a, c in cnt.items():
+    per[func.get(a, '?')] = per.get(func.get(a, '?'), 0) + c
+for f, c in sorted(per.items(), key=lambda x: -x[1])[:12]:
+    print(f'{c:>12} {100 * c / total:5.1f}%  {f[:100]}')
+print('hottest instructions, in address order:')
+hot = sorted(sorted(cnt, key=lambda a: -cnt[a])[:top])
+for a in hot:
+    print(f'{a:8x} {cnt[a]:>10}  {dis.get(a, "?")}')
