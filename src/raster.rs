@@ -654,33 +654,6 @@ fn span<R: SpanRecip, D: DrawTarget>(
     runs.finish(n)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The fast division equals `u128` division, on both of its paths and at their boundaries.
-    #[test]
-    fn div_u128_matches_u128_division() {
-        let mut s: u64 = 0x2545_F491_4F6C_DD1D;
-        let mut rnd = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
-        for k in 0..200_000 {
-            let d = (rnd() as u128 >> (rnd() % 64)).max(1) | if k % 7 == 0 { 1 << 62 } else { 0 };
-            let n = ((rnd() as u128) << 64 | rnd() as u128) >> (rnd() % 128);
-            assert_eq!(div_u128(n, d), n / d, "{n} / {d}");
-            let edge = (d << 64).saturating_sub(1 + (rnd() % 3) as u128);
-            assert_eq!(div_u128(edge, d), edge / d, "{edge} / {d}");
-        }
-        assert_eq!(div_round(-7, 2), -4);
-        assert_eq!(div_round(7, 2), 4);
-        assert_eq!(div_round(-5, 3), -2);
-    }
-}
-
 /// The lean loop of a tame span whose every pixel is in range: no range check, no leading-zero count.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -710,4 +683,31 @@ fn lean<R: SpanRecip, D: DrawTarget>(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The fast division equals `u128` division, on both of its paths and at their boundaries.
+    #[test]
+    fn div_u128_matches_u128_division() {
+        let mut s: u64 = 0x2545_F491_4F6C_DD1D;
+        let mut rnd = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        for k in 0..200_000 {
+            let d = (rnd() as u128 >> (rnd() % 64)).max(1) | if k % 7 == 0 { 1 << 62 } else { 0 };
+            let n = ((rnd() as u128) << 64 | rnd() as u128) >> (rnd() % 128);
+            assert_eq!(div_u128(n, d), n / d, "{n} / {d}");
+            let edge = (d << 64).saturating_sub(1 + (rnd() % 3) as u128);
+            assert_eq!(div_u128(edge, d), edge / d, "{edge} / {d}");
+        }
+        assert_eq!(div_round(-7, 2), -4);
+        assert_eq!(div_round(7, 2), 4);
+        assert_eq!(div_round(-5, 3), -2);
+    }
 }
