@@ -85,3 +85,56 @@ mod tests {
         assert_eq!(to_fixed(f32::NEG_INFINITY, 8, 12), Err(false));
     }
 }
+
+/// `floor(n / d)` for `0 < d < 2^62`, shift-and-subtract with a 64-bit remainder (`r < 2d < 2^63`), the quotient
+/// shifting into the dividend's register as the dividend shifts out. The plane solve divides numbers of up to ~90
+/// bits by areas below 2^44; the generic `u128` division of 32-bit targets is large (about 1.5 KiB inlined on the
+/// Cortex-M4) and takes a 128-bit step per quotient bit. When the quotient fits 64 bits (every triangle but extreme
+/// slivers) only `lo`'s significant bits are walked, with a 32-bit remainder when `d < 2^31` (small triangles).
+pub(crate) fn div_u128(n: u128, d: u64) -> u128 {
+    debug_assert!(d > 0 && d < 1 << 62);
+    let hi = (n >> 64) as u64;
+    if hi >= d {
+        let (mut r, mut q) = (0u64, n);
+        for _ in 0..128 {
+            r = (r << 1) | (q >> 127) as u64;
+            q <<= 1;
+            if r >= d {
+                r -= d;
+                q |= 1;
+            }
+        }
+        return q;
+    }
+    let mut lo = n as u64;
+    // With no high word, the leading zeros of `lo` are zero quotient bits: skip them.
+    let steps = if hi == 0 {
+        let z = lo.leading_zeros();
+        lo = lo.checked_shl(z).unwrap_or(0);
+        64 - z
+    } else {
+        64
+    };
+    if d < 1 << 31 {
+        let (d, mut r) = (d as u32, hi as u32);
+        for _ in 0..steps {
+            r = (r << 1) | (lo >> 63) as u32;
+            lo <<= 1;
+            if r >= d {
+                r -= d;
+                lo |= 1;
+            }
+        }
+    } else {
+        let mut r = hi;
+        for _ in 0..steps {
+            r = (r << 1) | (lo >> 63);
+            lo <<= 1;
+            if r >= d {
+                r -= d;
+                lo |= 1;
+            }
+        }
+    }
+    lo as u128
+}

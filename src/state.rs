@@ -1,6 +1,6 @@
 //! Render state: depth range, comparison, depth write, culling.
 
-use crate::fixed::split;
+use crate::fixed::{div_u128, split};
 use crate::Error;
 
 /// The largest `W_far / W_near`, and the largest `rhw * W_far` of a vertex: `2^30`.
@@ -94,9 +94,9 @@ impl DepthRange {
         let (ratio_m, ratio_d, ratio_e) = (mf as u64, mn as u64, ef - en);
         let e = ratio_e + TMAX_FRAC as i32;
         let t_max_q = if e >= 0 {
-            ((ratio_m as u128) << e) / ratio_d as u128
+            div_u128((ratio_m as u128) << e, ratio_d)
         } else {
-            ((ratio_m as u128) >> (-e).min(127)) / ratio_d as u128
+            div_u128((ratio_m as u128) >> (-e).min(127), ratio_d)
         };
         Ok(DepthRange {
             near: w_near,

@@ -36,6 +36,38 @@ fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick
     ok
 }
 
+/// The cost of banding, measured on this core: every scene drawn again in 60 bands of 4 rows; the extra
+/// instructions over the 30-band run, divided by the 30 extra bands, are what one band costs (triangle setup
+/// repeated for triangles spanning both halves, the span walk restarted, the binning test).
+fn band_overhead(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
+    let half = WIDTH as usize * BAND_ROWS / 2;
+    for scene in &SCENES {
+        let r30 = run_scene::<PerPixel<DefaultRecip>, _>(scene, color, depth, counter);
+        let r60 = run_scene::<PerPixel<DefaultRecip>, _>(
+            scene,
+            &mut color[..half],
+            &mut depth[..half],
+            counter,
+        );
+        match (r30, r60) {
+            (Ok(a), Ok(b)) if a.hash == b.hash => hprintln!(
+                "band-overhead board=qemu-m0 scene={} bands={}/{} instructions={}/{} instr_per_extra_band={}",
+                scene.name,
+                a.bands,
+                b.bands,
+                a.instructions,
+                b.instructions,
+                (b.instructions as i64 - a.instructions as i64) / (b.bands - a.bands) as i64
+            ),
+            _ => {
+                hprintln!("error board=qemu-m0 scene={} band-overhead run failed or differed", scene.name);
+                return false;
+            }
+        }
+    }
+    true
+}
+
 #[entry]
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];
@@ -43,7 +75,8 @@ fn main() -> ! {
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
     let ok = all::<PerPixel<DefaultRecip>>(COLOR, DEPTH, &mut counter)
-        & all::<PrevPixel>(COLOR, DEPTH, &mut counter);
+        & all::<PrevPixel>(COLOR, DEPTH, &mut counter)
+        & band_overhead(COLOR, DEPTH, &mut counter);
     debug::exit(if ok {
         debug::EXIT_SUCCESS
     } else {
