@@ -55,37 +55,6 @@ pub(crate) fn to_fixed(v: f32, frac_bits: i32, limit_log2: i32) -> Result<i64, b
     Ok(if neg { -r } else { r })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn to_fixed_matches_exact_rounding() {
-        // Each value is exactly representable, so f64 gives the exact product; ties to even.
-        let cases: &[f32] = &[
-            0.0,
-            -0.0,
-            1.0,
-            0.5 / 256.0,
-            1.5 / 256.0,
-            2.5 / 256.0,
-            -2.5 / 256.0,
-            100.123,
-            -4095.99,
-            1e-30,
-        ];
-        for &v in cases {
-            let exact = (v as f64) * 256.0;
-            let want = exact.round_ties_even() as i64;
-            assert_eq!(to_fixed(v, 8, 12), Ok(want), "{v}");
-        }
-        assert_eq!(to_fixed(4096.0, 8, 12), Err(true));
-        assert_eq!(to_fixed(4095.9998, 8, 12), Ok(1_048_576)); // rounds up to 4096.0 * 256, inside the band
-        assert_eq!(to_fixed(f32::NAN, 8, 12), Err(false));
-        assert_eq!(to_fixed(f32::NEG_INFINITY, 8, 12), Err(false));
-    }
-}
-
 /// `floor(n / d)` for `0 < d < 2^62`, shift-and-subtract with a 64-bit remainder (`r < 2d < 2^63`), the quotient
 /// shifting into the dividend's register as the dividend shifts out. The plane solve divides numbers of up to ~90
 /// bits by areas below 2^44; the generic `u128` division of 32-bit targets is large (about 1.5 KiB inlined on the
@@ -137,4 +106,35 @@ pub(crate) fn div_u128(n: u128, d: u64) -> u128 {
         }
     }
     lo as u128
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn to_fixed_matches_exact_rounding() {
+        // Each value is exactly representable, so f64 gives the exact product; ties to even.
+        let cases: &[f32] = &[
+            0.0,
+            -0.0,
+            1.0,
+            0.5 / 256.0,
+            1.5 / 256.0,
+            2.5 / 256.0,
+            -2.5 / 256.0,
+            100.123,
+            -4095.99,
+            1e-30,
+        ];
+        for &v in cases {
+            let exact = (v as f64) * 256.0;
+            let want = exact.round_ties_even() as i64;
+            assert_eq!(to_fixed(v, 8, 12), Ok(want), "{v}");
+        }
+        assert_eq!(to_fixed(4096.0, 8, 12), Err(true));
+        assert_eq!(to_fixed(4095.9998, 8, 12), Ok(1_048_576)); // rounds up to 4096.0 * 256, inside the band
+        assert_eq!(to_fixed(f32::NAN, 8, 12), Err(false));
+        assert_eq!(to_fixed(f32::NEG_INFINITY, 8, 12), Err(false));
+    }
 }
