@@ -7,16 +7,21 @@ elf, counts = sys.argv[1], sys.argv[2]
 top = int(sys.argv[3]) if len(sys.argv) > 3 else 60
 tools = glob.glob(os.path.expanduser('~/.rustup/toolchains/*/lib/rustlib/*/bin/llvm-objdump'))
 objdump = tools[0] if tools else 'llvm-objdump'
-dis, func, cur = {}, {}, '?'
-for line in subprocess.run([objdump, '-d', '-C', '--no-show-raw-insn', elf], capture_output=True, text=True).stdout.splitlines():
+dis, func, src, cur, where = {}, {}, {}, '?', '?'
+for line in subprocess.run([objdump, '-d', '-C', '-l', '--no-show-raw-insn', elf], capture_output=True, text=True).stdout.splitlines():
     m = re.match(r'^[0-9a-f]+ <(.*)>:', line)
     if m:
-        cur = m.group(1)
+        cur, where = m.group(1), '?'
+        continue
+    m = re.match(r'^; (/\S+?):(\d+)', line)
+    if m:
+        path = m.group(1)
+        where = ('wraster/' + path.split('/src/')[-1] if '/work/' in path and '/boards/' not in path else path.split('/')[-1]) + ':' + m.group(2)
         continue
     m = re.match(r'\s*([0-9a-f]+):\s+(.*)', line)
     if m:
         a = int(m.group(1), 16)
-        dis[a], func[a] = m.group(2).split('@')[0].strip(), cur
+        dis[a], func[a], src[a] = m.group(2).split('@')[0].strip(), cur, where
 cnt = {}
 for line in open(counts):
     a, c = line.split()
@@ -28,6 +33,12 @@ for a, c in cnt.items():
     per[func.get(a, '?')] = per.get(func.get(a, '?'), 0) + c
 for f, c in sorted(per.items(), key=lambda x: -x[1])[:12]:
     print(f'{c:>12} {100 * c / total:5.1f}%  {f[:100]}')
+print('by source line (DWARF; inlined code counts for the line it came from):')
+lines = {}
+for a, c in cnt.items():
+    lines[src.get(a, '?')] = lines.get(src.get(a, '?'), 0) + c
+for l, c in sorted(lines.items(), key=lambda x: -x[1])[:25]:
+    print(f'{c:>12} {100 * c / total:5.1f}%  {l}')
 print('hottest instructions, in address order:')
 hot = sorted(sorted(cnt, key=lambda a: -cnt[a])[:top])
 for a in hot:
