@@ -276,6 +276,29 @@ pub fn run_scene_with<R: SpanRecip, C: Counter>(
     })
 }
 
+/// Runs every standard scene with reciprocal `R` and prints its `bench` line (or an `error` line) through `print`;
+/// `false` when any scene failed.
+pub fn run_all<R: SpanRecip, C: Counter>(
+    board: &str,
+    core: &str,
+    color: &mut [u16],
+    depth: &mut [u16],
+    counter: &mut C,
+    mut print: impl FnMut(core::fmt::Arguments<'_>),
+) -> bool {
+    let mut ok = true;
+    for scene in &SCENES {
+        match run_scene::<R, C>(scene, color, depth, counter) {
+            Ok(run) => print(format_args!("{}", bench_line(board, core, &run))),
+            Err(e) => {
+                print(format_args!("error board={board} scene={} {e}", scene.name));
+                ok = false;
+            }
+        }
+    }
+    ok
+}
+
 /// `num / den` with one decimal, by integers.
 struct Ratio(u64, u64);
 

@@ -15,7 +15,7 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use panic_semihosting as _;
 use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
-use wraster_board::{bench_line, run_scene, SysTick, HEIGHT, SCENES, WIDTH};
+use wraster_board::{run_all, run_scene, SysTick, HEIGHT, SCENES, WIDTH};
 
 /// Rows per band: the largest multiple of 8 whose two buffers leave room for the stack in 16 KiB.
 const BAND_ROWS: usize = 8;
@@ -23,17 +23,9 @@ const PIXELS: usize = WIDTH as usize * BAND_ROWS;
 const _: () = assert!((HEIGHT as usize).is_multiple_of(BAND_ROWS));
 
 fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
-    let mut ok = true;
-    for scene in &SCENES {
-        match run_scene::<R, _>(scene, color, depth, counter) {
-            Ok(run) => hprintln!("{}", bench_line("qemu-m0", "m0", &run)),
-            Err(e) => {
-                hprintln!("error board=qemu-m0 scene={} {}", scene.name, e);
-                ok = false;
-            }
-        }
-    }
-    ok
+    run_all::<R, _>("qemu-m0", "m0", color, depth, counter, |line| {
+        hprintln!("{}", line)
+    })
 }
 
 /// The cost of banding, measured on this core: every scene drawn again in 60 bands of 4 rows; the extra

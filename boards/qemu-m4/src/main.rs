@@ -17,22 +17,14 @@ use panic_semihosting as _;
 #[cfg(not(feature = "size-probe"))]
 use wraster::recip::PrevPixel;
 use wraster::recip::{DefaultRecip, PerPixel, SpanRecip};
-use wraster_board::{bench_line, run_scene, SysTick, HEIGHT, SCENES, WIDTH};
+use wraster_board::{run_all, SysTick, HEIGHT, WIDTH};
 
 const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
 
 fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
-    let mut ok = true;
-    for scene in &SCENES {
-        match run_scene::<R, _>(scene, color, depth, counter) {
-            Ok(run) => hprintln!("{}", bench_line("qemu-m4", "m4", &run)),
-            Err(e) => {
-                hprintln!("error board=qemu-m4 scene={} {}", scene.name, e);
-                ok = false;
-            }
-        }
-    }
-    ok
+    run_all::<R, _>("qemu-m4", "m4", color, depth, counter, |line| {
+        hprintln!("{}", line)
+    })
 }
 
 #[entry]

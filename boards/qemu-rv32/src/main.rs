@@ -12,7 +12,7 @@
 use riscv_rt::entry;
 use riscv_semihosting::{debug, hprintln};
 use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
-use wraster_board::{bench_line, run_scene, Counter, HEIGHT, SCENES, WIDTH};
+use wraster_board::{run_all, Counter, HEIGHT, WIDTH};
 
 const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
 
@@ -28,17 +28,14 @@ impl Counter for Minstret {
 }
 
 fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16]) -> bool {
-    let mut ok = true;
-    for scene in &SCENES {
-        match run_scene::<R, _>(scene, color, depth, &mut Minstret(0)) {
-            Ok(run) => hprintln!("{}", bench_line("qemu-rv32", "rv32", &run)),
-            Err(e) => {
-                hprintln!("error board=qemu-rv32 scene={} {}", scene.name, e);
-                ok = false;
-            }
-        }
-    }
-    ok
+    run_all::<R, _>(
+        "qemu-rv32",
+        "rv32",
+        color,
+        depth,
+        &mut Minstret(0),
+        |line| hprintln!("{}", line),
+    )
 }
 
 #[entry]
