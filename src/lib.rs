@@ -39,6 +39,7 @@ mod depth;
 mod edge;
 mod error;
 mod fixed;
+pub mod format;
 mod raster;
 pub mod recip;
 #[cfg(feature = "scenes")]
