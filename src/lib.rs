@@ -40,6 +40,7 @@ mod edge;
 mod error;
 mod fixed;
 pub mod format;
+pub mod projection;
 mod raster;
 pub mod recip;
 #[cfg(feature = "scenes")]
