@@ -1,0 +1,191 @@
+//! World-space triangles through the projection, near-plane clipping and the viewport, checked against an
+//! independent f64 ray caster: for every pixel whose centre is unambiguously inside or outside (the same answer
+//! 0.75 px around it, so the 1/512 px vertex snap and f32 clip vertices cannot change it) coverage must agree, and
+//! the stored W16 code must be within 1 LSB plus what a 1/512 px snap of the vertices can move the depth there
+//! (bounded by the reference's code gradient over 0.75 px, divided by 128 to reach 1/512 px with a 2x margin).
+//! Triangles crossing the near plane and lying partly behind the eye are the peers' most reported bug
+//! ("flashing" or deforming near the camera): a sequence of frames moves one through the near plane and past the eye.
+
+use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+use host_tests::Frame;
+use wraster::clip::Viewport;
+use wraster::projection::{is_w_friendly, Mat4};
+use wraster::{DepthBuffer, Rasterizer, RenderState, W16_FAR};
+
+const W: u16 = 96;
+const H: u16 = 72;
+const NEAR: f64 = 1.0;
+const FAR: f64 = 400.0;
+/// cot(fov/2) for a 90 degree field of view.
+const S: f64 = 1.0;
+const ASPECT: f64 = W as f64 / H as f64;
+
+/// A W-friendly projection (fourth column [0, 0, 1, 0]: w = eye z).
+fn projection() -> Mat4 {
+    let q = FAR / (FAR - NEAR);
+    Mat4([
+        [(S / ASPECT) as f32, 0.0, 0.0, 0.0],
+        [0.0, S as f32, 0.0, 0.0],
+        [0.0, 0.0, q as f32, 1.0],
+        [0.0, 0.0, (-q * NEAR) as f32, 0.0],
+    ])
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The eye depth where the ray through screen point (sx, sy) meets the triangle, if inside it and in [NEAR, FAR].
+fn cast(t: &[[f64; 3]; 3], sx: f64, sy: f64) -> Option<f64> {
+    let xn = sx / (W as f64 / 2.0) - 1.0;
+    let yn = 1.0 - sy / (H as f64 / 2.0);
+    let dir = [xn * ASPECT / S, yn / S, 1.0];
+    let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    let den = dot(n, dir);
+    if den == 0.0 {
+        return None;
+    }
+    let z = dot(n, t[0]) / den;
+    if !(NEAR..=FAR).contains(&z) {
+        return None;
+    }
+    let p = [dir[0] * z, dir[1] * z, dir[2] * z];
+    let s: Vec<f64> = (0..3)
+        .map(|k| dot(n, cross(sub(t[(k + 1) % 3], t[k]), sub(p, t[k]))))
+        .collect();
+    (s.iter().all(|&v| v >= 0.0) || s.iter().all(|&v| v <= 0.0)).then_some(z)
+}
+
+fn code(z: f64) -> f64 {
+    (z / FAR * 65535.0).round()
+}
+
+/// Draws `t` and compares it with the ray caster; returns (pixels drawn, pixels compared).
+fn check(t: [[f32; 3]; 3]) -> (usize, usize) {
+    let m = projection();
+    assert!(is_w_friendly(&m));
+    let vp = Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: W as f32,
+        height: H as f32,
+    };
+    let mut frame = Frame::new(W as u32, H as u32);
+    let mut depth = vec![0u16; W as usize * H as usize];
+    let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
+    buf.clear();
+    let mut r: Rasterizer = Rasterizer::new(RenderState::new(NEAR as f32, FAR as f32).unwrap());
+    r.draw_world(&mut frame, &mut buf, &m, &vp, &t, Rgb565::WHITE)
+        .unwrap();
+    let tf = t.map(|v| v.map(|c| c as f64));
+    let (mut drawn, mut compared) = (0, 0);
+    for py in 0..H as usize {
+        for px in 0..W as usize {
+            let (cx, cy) = (px as f64 + 0.5, py as f64 + 0.5);
+            let probes: Vec<Option<f64>> = [
+                (0.0, 0.0),
+                (0.75, 0.0),
+                (-0.75, 0.0),
+                (0.0, 0.75),
+                (0.0, -0.75),
+            ]
+            .iter()
+            .map(|(dx, dy)| cast(&tf, cx + dx, cy + dy))
+            .collect();
+            let stored = depth[py * W as usize + px];
+            drawn += usize::from(stored != W16_FAR || frame.writes[py * W as usize + px] > 0);
+            if probes.iter().all(|p| p.is_some()) {
+                let z = probes[0].unwrap();
+                let grad = probes
+                    .iter()
+                    .map(|p| (code(p.unwrap()) - code(z)).abs())
+                    .fold(0.0, f64::max);
+                let bound = 1.0 + grad / 128.0;
+                assert!(
+                    frame.writes[py * W as usize + px] == 1,
+                    "pixel ({px},{py}) should be covered: {t:?}"
+                );
+                assert!(
+                    (stored as f64 - code(z)).abs() <= bound,
+                    "({px},{py}): {stored} vs {} (bound {bound}) {t:?}",
+                    code(z)
+                );
+                compared += 1;
+            } else if probes.iter().all(|p| p.is_none()) {
+                assert_eq!(
+                    frame.writes[py * W as usize + px],
+                    0,
+                    "pixel ({px},{py}) should be empty: {t:?}"
+                );
+                compared += 1;
+            }
+        }
+    }
+    (drawn, compared)
+}
+
+#[test]
+fn a_triangle_moving_through_the_near_plane_and_past_the_eye() {
+    let mut crossing_frames = 0;
+    for k in 0..120 {
+        let z = 6.0 - k as f32 * 0.1; // from 6 in front to 6 behind the eye
+        let t = [[-4.0, -1.5, z], [4.0, -1.0, z + 3.0], [0.5, 3.0, z + 1.5]];
+        let (drawn, compared) = check(t);
+        assert!(
+            compared > (W as usize * H as usize) / 2,
+            "frame {k}: too few unambiguous pixels"
+        );
+        let crosses =
+            t.iter().any(|v| (v[2] as f64) < NEAR) && t.iter().any(|v| (v[2] as f64) > NEAR);
+        if crosses && drawn > 0 {
+            crossing_frames += 1;
+        }
+    }
+    assert!(
+        crossing_frames >= 10,
+        "{crossing_frames} frames exercised the near-plane clip"
+    );
+}
+
+#[test]
+fn a_ground_plane_from_behind_the_eye_to_beyond_the_far_plane() {
+    for (k, y) in [-2.0f32, -0.5, -0.05].into_iter().enumerate() {
+        let t = [[-300.0, y, -50.0], [300.0, y, -50.0], [0.0, y, 800.0]];
+        let (drawn, _) = check(t);
+        assert!(drawn > 100, "case {k}: {drawn}");
+    }
+}
+
+#[test]
+fn bad_world_input_is_an_error_and_writes_nothing() {
+    let m = projection();
+    let vp = Viewport {
+        x: 0.0,
+        y: 0.0,
+        width: W as f32,
+        height: H as f32,
+    };
+    let mut frame = Frame::new(W as u32, H as u32);
+    let mut depth = vec![0u16; W as usize * H as usize];
+    let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
+    buf.clear();
+    let mut r: Rasterizer = Rasterizer::new(RenderState::new(1.0, 100.0).unwrap());
+    for bad in [f32::NAN, f32::INFINITY] {
+        let t = [[0.0, 0.0, 5.0], [1.0, bad, 5.0], [0.0, 1.0, 5.0]];
+        assert_eq!(
+            r.draw_world(&mut frame, &mut buf, &m, &vp, &t, Rgb565::RED),
+            Err(wraster::Error::NonFinite)
+        );
+    }
+    assert!(frame.writes.iter().all(|&n| n == 0));
+}
