@@ -15,7 +15,7 @@ use embedded_graphics_core::pixelcolor::PixelColor;
 use embedded_graphics_core::prelude::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 
-use crate::depth::{encode_w16, DepthBuffer};
+use crate::depth::{encode_w16, DepthBuffer, W16_FAR};
 use crate::edge::{Edge, Sub};
 use crate::fixed::{div_u128, round_shift, split, to_fixed};
 #[cfg(feature = "gouraud")]
@@ -240,6 +240,8 @@ impl<R: SpanRecip> Rasterizer<R> {
                 t_lo: 1u64 << s.frac,
                 t_hi: self.state.range.t_max(s.frac),
                 shift_base: 94 - s.frac,
+                #[cfg(feature = "bias")]
+                bias: bias_of(&self.state, &s.p, &s.t, s.frac),
             },
         }))
     }
@@ -337,7 +339,8 @@ impl<R: SpanRecip> Rasterizer<R> {
                             x: self.recip.recip(m),
                             lz,
                         };
-                        let code = encode_w16(inv.x, w.span.shift_base - inv.lz);
+                        let code =
+                            biased(encode_w16(inv.x, w.span.shift_base - inv.lz), w.span.bias());
                         let stored = &mut row[i as usize];
                         if cmp.test(code, *stored) {
                             if write {
@@ -471,6 +474,62 @@ struct SpanCtx {
     t_lo: u64,
     t_hi: u64,
     shift_base: u32,
+    /// The triangle's depth bias in codes (feature `bias`).
+    #[cfg(feature = "bias")]
+    bias: i32,
+}
+
+impl SpanCtx {
+    #[inline(always)]
+    fn bias(&self) -> i32 {
+        #[cfg(feature = "bias")]
+        return self.bias;
+        #[cfg(not(feature = "bias"))]
+        0
+    }
+}
+
+/// `code + bias`, saturated to the W16 range (a no-op for a zero bias).
+#[inline(always)]
+fn biased(code: u16, bias: i32) -> u16 {
+    if bias == 0 {
+        code
+    } else {
+        (code as i32 + bias).clamp(0, W16_FAR as i32) as u16
+    }
+}
+
+/// Seed 001_4caa61ee3442653f.txt's depth bias, `Offset = m * SLOPESCALEDEPTHBIAS + DEPTHBIAS`, in W16 codes.
+/// W is not planar in screen space, so `m` is defined for a triangle as the larger of `|d code / dx|` and
+/// `|d code / dy|` (codes per pixel) of the plane through its three vertices' exact codes `65535 W_i / W_far`: the
+/// slope the triangle's depth has at its vertices' scale, which is what two coplanar triangles' rounding disagrees by.
+/// Rounded to the nearest code; 0 when both terms are 0 (the common case costs no float work).
+#[cfg(feature = "bias")]
+fn bias_of(state: &RenderState, p: &[Sub; 3], t: &[i64; 3], frac: u32) -> i32 {
+    let (slope, constant) = (state.slope_scale_depth_bias, state.depth_bias);
+    if slope == 0.0 && constant == 0.0 {
+        return 0;
+    }
+    let full = (1u64 << frac) as f32 * W16_FAR as f32;
+    let c = t.map(|v| full / v as f32);
+    let (dx1, dy1) = ((p[1].x - p[0].x) as f32, (p[1].y - p[0].y) as f32);
+    let (dx2, dy2) = ((p[2].x - p[0].x) as f32, (p[2].y - p[0].y) as f32);
+    let area = dx1 * dy2 - dx2 * dy1;
+    let (c1, c2) = (c[1] - c[0], c[2] - c[0]);
+    // per sub-pixel, times 256 per pixel
+    let gx = (c1 * dy2 - c2 * dy1) / area * 256.0;
+    let gy = (c2 * dx1 - c1 * dx2) / area * 256.0;
+    let m = if gx.abs() > gy.abs() {
+        gx.abs()
+    } else {
+        gy.abs()
+    };
+    let off = m * slope + constant;
+    if !off.is_finite() {
+        return 0;
+    }
+    let r = if off >= 0.0 { off + 0.5 } else { off - 0.5 };
+    r.clamp(-(W16_FAR as f32), W16_FAR as f32) as i32
 }
 
 fn fill<D: DrawTarget>(
@@ -585,10 +644,20 @@ fn span<R: SpanRecip, D: DrawTarget>(
     if tame && in_range(t) && in_range(last) {
         recip.begin_span(smooth);
         // The comparison is chosen once per span: the default (Less) gets its own loop, the rest share one.
-        if cmp == Compare::Less {
-            lean(recip, row, t, dt, ctx, |a, b| a < b, write, runs)?;
+        if cmp == Compare::Less && ctx.bias() == 0 {
+            lean(recip, row, t, dt, ctx, |a, b| a < b, 0, write, runs)?;
         } else {
-            lean(recip, row, t, dt, ctx, |a, b| cmp.test(a, b), write, runs)?;
+            lean(
+                recip,
+                row,
+                t,
+                dt,
+                ctx,
+                |a, b| cmp.test(a, b),
+                ctx.bias(),
+                write,
+                runs,
+            )?;
         }
     } else {
         recip.begin_span(false);
@@ -597,7 +666,7 @@ fn span<R: SpanRecip, D: DrawTarget>(
             let mut pass = false;
             if in_range(t) {
                 let (m, lz) = normalise(t);
-                let code = encode_w16(recip.recip(m), ctx.shift_base - lz);
+                let code = biased(encode_w16(recip.recip(m), ctx.shift_base - lz), ctx.bias());
                 if cmp.test(code, *stored) {
                     if write {
                         *stored = code;
@@ -624,13 +693,14 @@ fn lean<R: SpanRecip, D: DrawTarget>(
     dt: i64,
     ctx: &SpanCtx,
     test: impl Fn(u16, u16) -> bool,
+    bias: i32,
     write: bool,
     runs: &mut Runs<'_, D>,
 ) -> Result<(), Error> {
     let mut walk = SpanWalker::new(t, dt);
     let mut enc = W16Enc::new(ctx.shift_base.wrapping_sub(walk.lz));
     for (k, stored) in row.iter_mut().enumerate() {
-        let code = enc.code::<R>(recip.recip(walk.m()));
+        let code = biased(enc.code::<R>(recip.recip(walk.m())), bias);
         if test(code, *stored) {
             if write {
                 *stored = code;

@@ -130,6 +130,12 @@ pub struct RenderState {
     pub depth_write: bool,
     /// Face culling.
     pub cull: Cull,
+    /// Constant depth bias, in W16 codes (feature `bias`; seed 001's DEPTHBIAS). Negative pulls towards the eye.
+    #[cfg(feature = "bias")]
+    pub depth_bias: f32,
+    /// Slope-scaled depth bias (feature `bias`; seed 001's SLOPESCALEDEPTHBIAS), times the triangle's `m`.
+    #[cfg(feature = "bias")]
+    pub slope_scale_depth_bias: f32,
 }
 
 impl RenderState {
@@ -140,6 +146,10 @@ impl RenderState {
             compare: Compare::Less,
             depth_write: true,
             cull: Cull::None,
+            #[cfg(feature = "bias")]
+            depth_bias: 0.0,
+            #[cfg(feature = "bias")]
+            slope_scale_depth_bias: 0.0,
         })
     }
 }

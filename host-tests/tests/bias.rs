@@ -1,0 +1,124 @@
+//! Depth bias (seed 001_4caa61ee3442653f.txt: `Offset = m * SLOPESCALEDEPTHBIAS + DEPTHBIAS`), in W16 codes.
+//!
+//! Two triangles in one plane (1/W affine in screen space, both evaluated from the same plane) fight: each stored
+//! code is within 1 LSB of its exact value (the core's depth bound), and the two exact values differ only by the
+//! f32 rounding of the vertices' RHW (about 65535 * 2^-22 codes, far below 1), so at a pixel the two stored codes
+//! differ by at most 3. With `Less`, a second triangle biased by -4 codes therefore wins at every pixel it covers
+//! (no fighting, no gaps), and one whose plane lies 2% farther (over 100 codes here) still loses everywhere.
+
+use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+use host_tests::Frame;
+use wraster::{Compare, DepthBuffer, Rasterizer, RenderState, Vertex};
+
+const W: u16 = 64;
+const H: u16 = 48;
+const FAR: f32 = 1000.0;
+
+/// 1/W of the plane at a screen point.
+fn rhw(x: f32, y: f32) -> f32 {
+    (0.05 - 0.0007 * x as f64 - 0.0006 * y as f64) as f32
+}
+
+fn tri(p: [(f32, f32); 3], scale: f32, c: Rgb565) -> [Vertex<Rgb565>; 3] {
+    p.map(|(x, y)| Vertex {
+        x,
+        y,
+        z: 0.5,
+        rhw: rhw(x, y) * scale,
+        color: c,
+    })
+}
+
+const A: [(f32, f32); 3] = [(2.0, 2.0), (62.0, 4.0), (4.0, 46.0)];
+const B: [(f32, f32); 3] = [(8.0, 7.0), (50.0, 12.0), (12.0, 38.0)];
+
+/// Pixels B covers, and how many of them show B after drawing A then B.
+fn visible(state: RenderState, b_scale: f32) -> (usize, usize) {
+    let mut frame = Frame::new(W as u32, H as u32);
+    let mut depth = vec![0u16; W as usize * H as usize];
+    let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
+    buf.clear();
+    let mut first = state;
+    first.depth_bias = 0.0;
+    first.slope_scale_depth_bias = 0.0;
+    Rasterizer::<wraster::recip::PerPixel<wraster::recip::DefaultRecip>>::new(first)
+        .draw(&mut frame, &mut buf, &tri(A, 1.0, Rgb565::RED))
+        .unwrap();
+    let before = frame.writes.clone();
+    let mut r: Rasterizer = Rasterizer::new(state);
+    r.draw(&mut frame, &mut buf, &tri(B, b_scale, Rgb565::BLUE))
+        .unwrap();
+    // B's coverage, drawn alone
+    let mut alone = Frame::new(W as u32, H as u32);
+    let mut d2 = vec![0u16; W as usize * H as usize];
+    let mut b2 = DepthBuffer::new(&mut d2, W, H).unwrap();
+    b2.clear();
+    let mut any = state;
+    any.compare = Compare::Always;
+    Rasterizer::<wraster::recip::PerPixel<wraster::recip::DefaultRecip>>::new(any)
+        .draw(&mut alone, &mut b2, &tri(B, b_scale, Rgb565::BLUE))
+        .unwrap();
+    let covered: Vec<usize> = (0..alone.px.len())
+        .filter(|&p| alone.writes[p] > 0)
+        .collect();
+    assert!(covered.iter().all(|&p| before[p] > 0), "B lies inside A");
+    let shown = covered
+        .iter()
+        .filter(|&&p| frame.px[p] == Rgb565::BLUE)
+        .count();
+    (covered.len(), shown)
+}
+
+/// m of B as the bias defines it, computed here in f64: the larger screen gradient of the plane through B's
+/// vertex codes `65535 W / W_far`.
+fn m_of_b() -> f64 {
+    let c: Vec<f64> = B
+        .iter()
+        .map(|&(x, y)| 65535.0 / (FAR as f64 * rhw(x, y) as f64))
+        .collect();
+    let (x, y): (Vec<f64>, Vec<f64>) = B.iter().map(|&(x, y)| (x as f64, y as f64)).unzip();
+    let area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+    let gx = ((c[1] - c[0]) * (y[2] - y[0]) - (c[2] - c[0]) * (y[1] - y[0])) / area;
+    let gy = ((c[2] - c[0]) * (x[1] - x[0]) - (c[1] - c[0]) * (x[2] - x[0])) / area;
+    gx.abs().max(gy.abs())
+}
+
+#[test]
+fn bias_removes_coplanar_fighting_without_gaps() {
+    let base = RenderState::new(1.0, FAR).unwrap();
+    let (covered, shown) = visible(base, 1.0);
+    println!("no bias: B shows on {shown} of {covered} pixels");
+    assert!(
+        covered > 300 && shown < covered,
+        "without bias the coplanar pair fights (B is not fully shown)"
+    );
+
+    let constant = RenderState {
+        depth_bias: -4.0,
+        ..base
+    };
+    let (covered, shown) = visible(constant, 1.0);
+    println!("depth_bias -4: {shown} of {covered}");
+    assert_eq!(
+        shown, covered,
+        "with bias -4 (> the 3-code bound) B shows everywhere, no gaps"
+    );
+
+    let m = m_of_b();
+    assert!(m > 1.0, "a sloped plane: m = {m}");
+    // slope scale alone: offset = m * (-4.5 / m) = -4.5, rounded to -5 (or -4 with f32 rounding of m): enough.
+    let sloped = RenderState {
+        slope_scale_depth_bias: (-4.5 / m) as f32,
+        ..base
+    };
+    let (covered, shown) = visible(sloped, 1.0);
+    println!(
+        "slope scale {:.4} (m = {m:.2}): {shown} of {covered}",
+        -4.5 / m
+    );
+    assert_eq!(shown, covered);
+
+    // a surface 2% farther (its codes over 100 larger here) stays hidden under the same bias: no bleeding
+    let (covered, shown) = visible(constant, 1.0 / 1.02);
+    assert_eq!(shown, 0, "{shown} of {covered} pixels bled through");
+}
