@@ -4,10 +4,95 @@
 
 use std::time::Instant;
 
-use host_tests::{reference_frame, render};
+use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+use host_tests::{reference_frame, reference_tri, render, Frame};
+use wraster::format::{DepthFormat, W16, W16F, Z16};
 use wraster::recip::{DefaultRecip, PerPixel};
 use wraster::scenes::{Scene, HEIGHT, WIDTH};
 use wraster::RenderState;
+
+/// The winning triangle per pixel when the scene's depths are stored in format `F` and compared with Less, on the
+/// f64 reference's coverage and exact per-pixel depth: the storage format is the only thing that differs.
+/// (The rasterizer itself writes W16 only so far; this isolates what each format can resolve.)
+fn winners<F: DepthFormat>(
+    tris: &[[wraster::Vertex<Rgb565>; 3]],
+    near: f32,
+    far: f32,
+) -> Vec<Option<usize>> {
+    let n = WIDTH as usize * HEIGHT as usize;
+    let (mut code, mut win) = (
+        vec![F::encode(far as f64, near as f64, far as f64); n],
+        vec![None; n],
+    );
+    let exact = F::NAME == "exact";
+    let mut best = vec![f64::INFINITY; n];
+    for (k, tri) in tris.iter().enumerate() {
+        let v = tri.map(|q| (q.x, q.y, q.rhw));
+        for p in reference_tri(&v, near, far, WIDTH as i32, 0..HEIGHT as i32).unwrap_or_default() {
+            if !p.in_range {
+                continue;
+            }
+            let i = p.y as usize * WIDTH as usize + p.x as usize;
+            let d = far as f64 / p.t;
+            let c = F::encode(d, near as f64, far as f64);
+            let pass = if exact { d < best[i] } else { c < code[i] };
+            if pass {
+                code[i] = c;
+                best[i] = d;
+                win[i] = Some(k);
+            }
+        }
+    }
+    win
+}
+
+/// Exact f64 visibility (the nearest surface at each pixel), as a "format" for [`winners`].
+struct Exact;
+impl DepthFormat for Exact {
+    const NAME: &'static str = "exact";
+    const BYTES: usize = 4;
+    const MAX_CODE: u32 = u32::MAX;
+    fn encode(_d: f64, _n: f64, _f: f64) -> u32 {
+        0
+    }
+    fn decode(_c: u32, _n: f64, f: f64) -> f64 {
+        f
+    }
+    fn fraction(_c: u32, _n: f64, _f: f64) -> f64 {
+        0.0
+    }
+}
+
+/// The side-by-side: Z16, W16 and W16F panels, pixels whose visible surface differs from the f64 reference in
+/// magenta; prints one `formats` line per format and returns the PNG path.
+fn side_by_side(tris: &[[wraster::Vertex<Rgb565>; 3]], near: f32, far: f32) -> std::path::PathBuf {
+    let truth = winners::<Exact>(tris, near, far);
+    let (w, h) = (WIDTH as usize, HEIGHT as usize);
+    let mut out = Frame::new(3 * WIDTH as u32 + 8, HEIGHT as u32);
+    let panels = [
+        (Z16::NAME, winners::<Z16>(tris, near, far)),
+        (W16::NAME, winners::<W16>(tris, near, far)),
+        (W16F::NAME, winners::<W16F>(tris, near, far)),
+    ];
+    for (k, (name, win)) in panels.iter().enumerate() {
+        let mut differ = 0;
+        for i in 0..w * h {
+            let c = if win[i] != truth[i] {
+                differ += 1;
+                Rgb565::MAGENTA
+            } else {
+                win[i].map_or(Rgb565::BLACK, |t| tris[t][0].color)
+            };
+            out.px[(i / w) * out.w as usize + k * (w + 4) + i % w] = c;
+        }
+        println!(
+            "formats scene=terrain format={name} near={near} far={far} visibility_differs={differ}"
+        );
+    }
+    let png = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/demo/formats.png");
+    out.save_png(&png);
+    png.canonicalize().unwrap_or(png)
+}
 
 fn main() {
     let scene = Scene::Terrain;
@@ -44,6 +129,8 @@ fn main() {
     let png = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/demo/terrain.png");
     frame.save_png(&png);
     let png = png.canonicalize().unwrap_or(png);
+    let formats_png = side_by_side(&tris, near, far);
+    println!("formats png={}", formats_png.display());
     println!(
         "triangles={} fragments={} written={} culled={}",
         tris.len(),
