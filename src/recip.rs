@@ -172,6 +172,21 @@ impl<S: Seed, const STEPS: usize> Recip32 for Newton<S, STEPS> {
     }
 }
 
+/// One f32 division (a single instruction on an FPU core such as the Cortex-M4F; soft-float elsewhere): `m` rounds to
+/// f32 (`2^-24` relative), the quotient rounds (`2^-24`), the conversion back truncates (below `2^-30` of
+/// `x >= 2^30`); together below `2^-23 + 2^-30 + 2^-47`. A strategy to measure against the fixed-point ones.
+pub struct F32Div;
+
+impl Recip32 for F32Div {
+    const NAME: &'static str = "f32-div";
+    const MAX_REL_ERROR: f64 =
+        2.0 / (1u64 << 24) as f64 + 1.0 / (1u64 << 30) as f64 + 1.0 / (1u64 << 47) as f64;
+    #[inline(always)]
+    fn recip(m: u32) -> u32 {
+        ((1u64 << 62) as f32 / m as f32) as u32
+    }
+}
+
 /// The default: piecewise-linear seed and one step (about 28 bits, two multiplies and a table read per pixel).
 pub type DefaultRecip = Newton<Lerp64, 1>;
 
@@ -430,6 +445,11 @@ mod tests {
         assert_bound::<Newton<Table64, 0>>(6.9);
         assert_bound::<Newton<Table64, 1>>(13.8);
         assert_bound::<Newton<Table64, 2>>(27.4);
+    }
+
+    #[test]
+    fn f32_division() {
+        assert_bound::<F32Div>(22.9);
     }
 
     #[test]

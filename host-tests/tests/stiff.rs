@@ -1,11 +1,11 @@
 //! Stiff and extreme cases (issue 5), each with its expected behaviour and the core's derived bound: coverage equal
 //! to the exact reference and every stored code within 1 LSB of the correctly rounded one (the default reciprocal's
-//! 2^-28.2 and the previous-pixel seed's 2^-21.98 relative error are both far below the 2^-17 a code can absorb;
+//! 2^-28.2, the previous-pixel seed's 2^-21.98 and one f32 division's 2^-23 relative error are all far below the 2^-17 a code can absorb;
 //! ARCHITECTURE.md), or a clear error with nothing written.
 
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
 use host_tests::{reference_tri, Frame, Rng};
-use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
+use wraster::recip::{DefaultRecip, F32Div, PerPixel, PrevPixel, SpanRecip};
 use wraster::{Compare, DepthBuffer, Error, Rasterizer, RenderState, Vertex, W16_FAR};
 
 /// Draws `tri` alone (Always) in a `w x h` buffer and checks it against the reference; returns (pixels, exact).
@@ -66,6 +66,9 @@ fn vtx(x: f64, y: f64, w: f64) -> Vertex<Rgb565> {
 fn both(tri: [Vertex<Rgb565>; 3], near: f32, far: f32, w: u16, h: u16) -> u64 {
     let (p, _) = check::<PerPixel<DefaultRecip>>(tri, near, far, w, h);
     let (q, _) = check::<PrevPixel>(tri, near, far, w, h);
+    assert_eq!(p, q);
+    // the f32-division strategy's 2^-23 is also far below 2^-17
+    let (q, _) = check::<PerPixel<F32Div>>(tri, near, far, w, h);
     assert_eq!(p, q);
     p
 }

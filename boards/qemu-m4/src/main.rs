@@ -37,6 +37,9 @@ fn main() -> ! {
     // `--features size-probe` links the default path only, to measure the library's share of .text (README).
     #[cfg(not(feature = "size-probe"))]
     let ok = ok & all::<PrevPixel>(COLOR, DEPTH, &mut counter);
+    // `--features f32-div` adds the f32-division reciprocal (one VDIV on this core), for comparison (README).
+    #[cfg(feature = "f32-div")]
+    let ok = ok & all::<PerPixel<wraster::recip::F32Div>>(COLOR, DEPTH, &mut counter);
     debug::exit(if ok {
         debug::EXIT_SUCCESS
     } else {
