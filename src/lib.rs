@@ -35,6 +35,10 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+// Unit tests print their measurements and use f64 functions: std for tests only.
+#[cfg(test)]
+extern crate std;
+
 pub mod clip;
 mod depth;
 mod edge;

@@ -428,8 +428,6 @@ mod tests {
         );
     }
 
-    extern crate std;
-
     #[test]
     fn linear_seed_and_steps() {
         // precision.md: 4.1, 8.2, 16.3 bits after 0, 1, 2 steps; the fixed-point floor (2^-29) caps step 3.
