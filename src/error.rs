@@ -25,6 +25,8 @@ pub enum Error {
     },
     /// The colour target returned an error.
     Target,
+    /// Z buffering asked for with a depth format that stores W (see [`crate::DepthMode`]).
+    ZWithWFormat,
 }
 
 impl fmt::Display for Error {
@@ -36,10 +38,10 @@ impl fmt::Display for Error {
             }
             Error::OutOfGuardBand => f.write_str("vertex outside the guard band of +-4096 pixels"),
             Error::DepthRange => {
-                f.write_str("rhw * W_far above 2^24: vertex too near the eye for the depth range")
+                f.write_str("rhw * W_far above 2^30: vertex too near the eye for the depth range")
             }
             Error::InvalidDepthRange => {
-                f.write_str("depth range needs 0 < W_near < W_far and W_far/W_near <= 2^24")
+                f.write_str("depth range needs 0 < W_near < W_far and W_far/W_near <= 2^30")
             }
             Error::BufferSize { expected, actual } => {
                 write!(
@@ -48,6 +50,9 @@ impl fmt::Display for Error {
                 )
             }
             Error::Target => f.write_str("the draw target returned an error"),
+            Error::ZWithWFormat => {
+                f.write_str("Z buffering asked for with a depth format that stores W")
+            }
         }
     }
 }

@@ -45,6 +45,7 @@ mod edge;
 mod error;
 mod fixed;
 pub mod format;
+pub mod packed;
 pub mod projection;
 mod raster;
 pub mod recip;
@@ -54,5 +55,6 @@ mod state;
 
 pub use depth::{DepthBuffer, DepthStore, W16_FAR};
 pub use error::Error;
+pub use packed::{Codec, Packed, Resolved};
 pub use raster::{row_range, Rasterizer, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS};
-pub use state::{Compare, Cull, DepthRange, RenderState, MAX_T};
+pub use state::{Compare, Cull, DepthMode, DepthRange, RenderState, MAX_T};

@@ -20,8 +20,8 @@ use crate::edge::{Edge, Sub};
 use crate::fixed::{div_u128, round_shift, split, to_fixed};
 #[cfg(feature = "gouraud")]
 use crate::recip::Inv;
-use crate::recip::{normalise, DefaultRecip, PerPixel, SpanRecip, SpanWalker};
-use crate::state::Compare;
+use crate::recip::{normalise, DefaultRecip, PerPixel, SpanRecip, SpanWalker, WSpan};
+use crate::state::{Compare, DepthMode};
 use crate::state::{Cull, RenderState, MAX_T_LOG2};
 use crate::Error;
 #[cfg(feature = "gouraud")]
@@ -82,10 +82,10 @@ impl core::ops::AddAssign for Stats {
 }
 
 /// A triangle after snapping and checks.
-struct Setup {
-    p: [Sub; 3],
-    t: [i64; 3],
-    frac: u32,
+pub(crate) struct Setup {
+    pub(crate) p: [Sub; 3],
+    pub(crate) t: [i64; 3],
+    pub(crate) frac: u32,
 }
 
 // Out of line: one copy instead of one per coordinate (flash), for a few instructions per vertex.
@@ -146,14 +146,15 @@ fn div_round(n: i128, d: i128) -> i128 {
     }
 }
 
-/// Draws triangles into a colour target and a W16 buffer, with reciprocal strategy `R`.
-pub struct Rasterizer<R: SpanRecip = PerPixel<DefaultRecip>> {
+/// Draws triangles into a colour target and a depth buffer, with `W` strategy `R` (a per-pixel reciprocal
+/// [`SpanRecip`], or [`crate::recip::Quake`] for the packed formats).
+pub struct Rasterizer<R: WSpan = PerPixel<DefaultRecip>> {
     /// The render state used by the next draws.
     pub state: RenderState,
-    recip: R,
+    pub(crate) recip: R,
 }
 
-impl<R: SpanRecip> Rasterizer<R> {
+impl<R: WSpan> Rasterizer<R> {
     /// A rasterizer with `state`.
     pub fn new(state: RenderState) -> Self {
         Rasterizer {
@@ -162,7 +163,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         }
     }
 
-    fn setup<C>(&self, v: &[Vertex<C>; 3]) -> Result<Setup, Error> {
+    pub(crate) fn setup<C>(&self, v: &[Vertex<C>; 3]) -> Result<Setup, Error> {
         let (_, fm, fe) = split(self.state.range.far()).ok_or(Error::NonFinite)?;
         let mut p = [Sub { x: 0, y: 0 }; 3];
         let mut tm = [(0u64, 0i32); 3];
@@ -189,10 +190,11 @@ impl<R: SpanRecip> Rasterizer<R> {
 
     /// Snaps, checks, culls and clips a triangle to the buffer's rows, and solves its `t` plane.
     /// `Ok(Err(stats))` when there is nothing to walk (culled, or no row in the buffer).
-    fn prepare<C>(
+    /// `rows` is the buffer's first frame row and its height.
+    pub(crate) fn prepare<C>(
         &self,
         v: &[Vertex<C>; 3],
-        depth: &DepthBuffer<'_>,
+        rows: (i32, u16),
     ) -> Result<Result<Walk, Stats>, Error> {
         let s = self.setup(v)?;
         let [p0, p1, p2] = s.p;
@@ -213,8 +215,8 @@ impl<R: SpanRecip> Rasterizer<R> {
         let p = order.map(|k| s.p[k]);
 
         let (j_first, j_last) = rows_of(&p);
-        let j0 = j_first.max(depth.y0());
-        let j1 = j_last.min(depth.y0() + depth.height() as i32 - 1);
+        let j0 = j_first.max(rows.0);
+        let j1 = j_last.min(rows.0 + rows.1 as i32 - 1);
         if j0 > j1 {
             return Ok(Err(Stats::default()));
         }
@@ -227,6 +229,8 @@ impl<R: SpanRecip> Rasterizer<R> {
         };
         let t = Plane::solve(order.map(|k| s.t[k]), &geom);
         Ok(Ok(Walk {
+            frac: s.frac,
+            t_vertex: order.map(|k| s.t[k]),
             edges: [
                 Edge::new(p[0], p[1], j0),
                 Edge::new(p[1], p[2], j0),
@@ -245,8 +249,21 @@ impl<R: SpanRecip> Rasterizer<R> {
             },
         }))
     }
+}
 
-    /// Draws one flat-coloured triangle (the colour of its first vertex). On an error nothing is written.
+impl<R: SpanRecip> Rasterizer<R> {
+    /// The comparison and depth write of a W16 draw: `Off` passes everything and writes nothing, `Z` is refused
+    /// (W16 stores W; see [`DepthMode`]).
+    fn w16_test(&self) -> Result<(Compare, bool), Error> {
+        match self.state.mode {
+            DepthMode::Off => Ok((Compare::Always, false)),
+            DepthMode::Z => Err(Error::ZWithWFormat),
+            DepthMode::W => Ok((self.state.compare, self.state.depth_write)),
+        }
+    }
+
+    /// Draws one flat-coloured triangle (the colour of its first vertex) into a W16 buffer: the lean path.
+    /// On an error nothing is written.
     pub fn draw<D>(
         &mut self,
         target: &mut D,
@@ -257,12 +274,12 @@ impl<R: SpanRecip> Rasterizer<R> {
         D: DrawTarget,
         D::Color: PixelColor,
     {
-        let mut w = match self.prepare(v, depth)? {
+        let (cmp, write) = self.w16_test()?;
+        let mut w = match self.prepare(v, (depth.y0(), depth.height()))? {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
         };
         let color = v[0].color;
-        let (cmp, write) = (self.state.compare, self.state.depth_write);
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {
             if let Some((lo, hi)) = w.row(depth.width()) {
@@ -308,8 +325,9 @@ impl<R: SpanRecip> Rasterizer<R> {
         D: DrawTarget,
         D::Color: PixelColor + From<Rgb888> + Into<Rgb888>,
     {
+        let (cmp, write) = self.w16_test()?;
         let s_t = self.setup(v)?.t;
-        let mut w = match self.prepare(v, depth)? {
+        let mut w = match self.prepare(v, (depth.y0(), depth.height()))? {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
         };
@@ -324,7 +342,6 @@ impl<R: SpanRecip> Rasterizer<R> {
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {
             if let Some((lo, hi)) = w.row(depth.width()) {
-                let (cmp, write) = (self.state.compare, self.state.depth_write);
                 let row = depth.row_mut(j);
                 let off = lo as i64 - w.geom.i_ref;
                 let mut t = w.t.at(off) as u64;
@@ -393,25 +410,25 @@ impl<R: SpanRecip> Rasterizer<R> {
 }
 
 /// Positions of the oriented triangle and the reference pixel of its planes: column `i_ref`, row `j0`.
-struct Geom {
-    p: [Sub; 3],
-    area: i128,
-    i_ref: i64,
-    j0: i32,
+pub(crate) struct Geom {
+    pub(crate) p: [Sub; 3],
+    pub(crate) area: i128,
+    pub(crate) i_ref: i64,
+    pub(crate) j0: i32,
 }
 
 /// A quantity linear in screen space: its value at `(i_ref, current row)` and its steps per column and row.
 #[derive(Clone, Copy)]
-struct Plane {
-    row: i64,
-    sx: i64,
-    sy: i64,
+pub(crate) struct Plane {
+    pub(crate) row: i64,
+    pub(crate) sx: i64,
+    pub(crate) sy: i64,
 }
 
 impl Plane {
     /// Solves `V(X, Y) = V0 + (gx (X - X0) + gy (Y - Y0)) / area` exactly in i128 (X, Y in sub-pixels) and rounds
     /// the steps and the reference value once each. Steps may wrap for slivers (see the module doc).
-    fn solve(v: [i64; 3], g: &Geom) -> Plane {
+    pub(crate) fn solve(v: [i64; 3], g: &Geom) -> Plane {
         let [p0, p1, p2] = g.p;
         let (d1, d2) = (v[1] as i128 - v[0] as i128, v[2] as i128 - v[0] as i128);
         let gx = d1 * (p2.y - p0.y) as i128 - d2 * (p1.y - p0.y) as i128;
@@ -427,31 +444,35 @@ impl Plane {
         }
     }
     #[inline(always)]
-    fn at(&self, di: i64) -> i64 {
+    pub(crate) fn at(&self, di: i64) -> i64 {
         self.row.wrapping_add(self.sx.wrapping_mul(di))
     }
     #[inline(always)]
-    fn next_row(&mut self) {
+    pub(crate) fn next_row(&mut self) {
         self.row = self.row.wrapping_add(self.sy);
     }
 }
 
 /// A prepared triangle being walked row by row.
-struct Walk {
+pub(crate) struct Walk {
+    /// Fraction bits of `T`.
+    pub(crate) frac: u32,
+    /// The vertices' `T`, in oriented order.
+    pub(crate) t_vertex: [i64; 3],
     edges: [Edge; 3],
-    geom: Geom,
+    pub(crate) geom: Geom,
     /// Vertex order after orientation.
     #[cfg_attr(not(feature = "gouraud"), allow(dead_code))]
     order: [usize; 3],
-    j1: i32,
-    t: Plane,
-    span: SpanCtx,
+    pub(crate) j1: i32,
+    pub(crate) t: Plane,
+    pub(crate) span: SpanCtx,
 }
 
 impl Walk {
     /// The covered columns `[lo, hi)` of the current row inside `[0, width)`, if any.
     #[inline(always)]
-    fn row(&self, width: u16) -> Option<(i32, i32)> {
+    pub(crate) fn row(&self, width: u16) -> Option<(i32, i32)> {
         let (mut lo, mut hi) = (0i64, width as i64);
         for e in &self.edges {
             let (l, h) = e.bound();
@@ -461,7 +482,7 @@ impl Walk {
         (lo < hi).then_some((lo as i32, hi as i32))
     }
     #[inline(always)]
-    fn next_row(&mut self) {
+    pub(crate) fn next_row(&mut self) {
         for e in &mut self.edges {
             e.step();
         }
@@ -470,9 +491,9 @@ impl Walk {
 }
 
 /// Per-triangle constants of the span loop: the `T` range drawn (far plane `2^F`, near plane) and `94 - F`.
-struct SpanCtx {
-    t_lo: u64,
-    t_hi: u64,
+pub(crate) struct SpanCtx {
+    pub(crate) t_lo: u64,
+    pub(crate) t_hi: u64,
     shift_base: u32,
     /// The triangle's depth bias in codes (feature `bias`).
     #[cfg(feature = "bias")]
@@ -506,12 +527,19 @@ fn biased(code: u16, bias: i32) -> u16 {
 /// Rounded to the nearest code; 0 when both terms are 0 (the common case costs no float work).
 #[cfg(feature = "bias")]
 fn bias_of(state: &RenderState, p: &[Sub; 3], t: &[i64; 3], frac: u32) -> i32 {
-    let (slope, constant) = (state.slope_scale_depth_bias, state.depth_bias);
-    if slope == 0.0 && constant == 0.0 {
+    if state.slope_scale_depth_bias == 0.0 && state.depth_bias == 0.0 {
         return 0;
     }
     let full = (1u64 << frac) as f32 * W16_FAR as f32;
-    let c = t.map(|v| full / v as f32);
+    slope_bias(state, p, t.map(|v| full / v as f32), W16_FAR as f32)
+}
+
+/// Seed 001's offset `m * slope + constant` for a triangle whose vertices' codes are `c` (any format's codes, as
+/// `f32`): `m` is the larger of `|d code / dx|` and `|d code / dy|` (codes per pixel) of the plane through them.
+/// Rounded to the nearest code and clamped to `[-max, max]`.
+#[cfg(feature = "bias")]
+pub(crate) fn slope_bias(state: &RenderState, p: &[Sub; 3], c: [f32; 3], max: f32) -> i32 {
+    let (slope, constant) = (state.slope_scale_depth_bias, state.depth_bias);
     let (dx1, dy1) = ((p[1].x - p[0].x) as f32, (p[1].y - p[0].y) as f32);
     let (dx2, dy2) = ((p[2].x - p[0].x) as f32, (p[2].y - p[0].y) as f32);
     let area = dx1 * dy2 - dx2 * dy1;
@@ -529,7 +557,7 @@ fn bias_of(state: &RenderState, p: &[Sub; 3], t: &[i64; 3], frac: u32) -> i32 {
         return 0;
     }
     let r = if off >= 0.0 { off + 0.5 } else { off - 0.5 };
-    r.clamp(-(W16_FAR as f32), W16_FAR as f32) as i32
+    r.clamp(-max, max) as i32
 }
 
 fn fill<D: DrawTarget>(
@@ -544,20 +572,20 @@ fn fill<D: DrawTarget>(
 }
 
 /// The passing runs of a span, each sent to the target as one `fill_solid`; counts the failing pixels.
-struct Runs<'a, D: DrawTarget> {
-    target: &'a mut D,
-    lo: i32,
-    j: i32,
-    color: D::Color,
+pub(crate) struct Runs<'a, D: DrawTarget> {
+    pub(crate) target: &'a mut D,
+    pub(crate) lo: i32,
+    pub(crate) j: i32,
+    pub(crate) color: D::Color,
     /// First pixel (span-relative) of the current run.
-    start: usize,
-    fails: u32,
+    pub(crate) start: usize,
+    pub(crate) fails: u32,
 }
 
 impl<D: DrawTarget> Runs<'_, D> {
     /// Pixel `k` failed: flush the run before it.
     #[inline(always)]
-    fn fail(&mut self, k: usize) -> Result<(), Error> {
+    pub(crate) fn fail(&mut self, k: usize) -> Result<(), Error> {
         self.fails += 1;
         let start = core::mem::replace(&mut self.start, k + 1);
         if start < k {
@@ -572,7 +600,7 @@ impl<D: DrawTarget> Runs<'_, D> {
         Ok(())
     }
     #[inline(always)]
-    fn finish(&mut self, n: usize) -> Result<(), Error> {
+    pub(crate) fn finish(&mut self, n: usize) -> Result<(), Error> {
         if self.start < n {
             fill(
                 self.target,

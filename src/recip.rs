@@ -379,6 +379,156 @@ impl SpanWalker {
     }
 }
 
+/// `W / W_far` of a pixel as `u = 2^(62 + frac) / T` rounded (Q0.62, exact to half a unit): one 128/64 division.
+/// `T >= 2^frac` (`t >= 1`: not beyond the far plane), so `u <= 2^62`.
+#[inline]
+pub fn exact_u(t: u64, frac: u32) -> u64 {
+    crate::fixed::div_u128((1u128 << (62 + frac)) + (t as u128 >> 1), t) as u64
+}
+
+/// How the span loop of any depth format gets `u = W / W_far` (Q0.62) for each pixel of a span from the
+/// screen-linear `T = t 2^frac`: every [`SpanRecip`] (a reciprocal per pixel), or [`Quake`] (an exact reciprocal every
+/// `N` pixels, `W` linear between). Only the strategy a firmware names is linked.
+pub trait WSpan: Default {
+    /// Short name for reports.
+    const NAME: &'static str;
+    /// Walks a span of `n >= 1` pixels whose `T` starts at `t0` and steps by `dt`, calling `px(k, Some(u))` for each
+    /// pixel `k` whose `T` lies in `[lo, hi]` (`lo = 2^frac`, the far plane) and `px(k, None)` for the others, in order.
+    #[allow(clippy::too_many_arguments)]
+    fn walk<E>(
+        &mut self,
+        t0: u64,
+        dt: i64,
+        n: usize,
+        frac: u32,
+        lo: u64,
+        hi: u64,
+        px: impl FnMut(usize, Option<u64>) -> Result<(), E>,
+    ) -> Result<(), E>;
+}
+
+/// Both ends of the span in `[lo, hi]`, so every pixel is (`T` is linear along it).
+#[inline(always)]
+fn ends_in(t0: u64, dt: i64, n: usize, lo: u64, hi: u64) -> bool {
+    let last = t0.wrapping_add((dt as u64).wrapping_mul(n as u64 - 1));
+    t0 >= lo && t0 <= hi && last >= lo && last <= hi
+}
+
+impl<R: SpanRecip> WSpan for R {
+    const NAME: &'static str = R::NAME;
+    #[inline(always)]
+    fn walk<E>(
+        &mut self,
+        t0: u64,
+        dt: i64,
+        n: usize,
+        frac: u32,
+        lo: u64,
+        hi: u64,
+        mut px: impl FnMut(usize, Option<u64>) -> Result<(), E>,
+    ) -> Result<(), E> {
+        // 1/t = x 2^(frac + lz - 94) (crate::raster), so u = x << (frac + lz - 32); the shift is in [1, 31] for
+        // t in [1, 2^30].
+        let (tame, smooth) = SpanWalker::classify(t0, dt, n as u32);
+        if tame && ends_in(t0, dt, n, lo, hi) {
+            self.begin_span(smooth);
+            let mut w = SpanWalker::new(t0, dt);
+            for k in 0..n {
+                let x = self.recip(w.m());
+                px(k, Some((x as u64) << (frac + w.lz - 32)))?;
+                w.step(self);
+            }
+        } else {
+            self.begin_span(false);
+            let mut t = t0;
+            for k in 0..n {
+                if t >= lo && t <= hi {
+                    let (m, lz) = normalise(t);
+                    px(k, Some((self.recip(m) as u64) << (frac + lz - 32)))?;
+                } else {
+                    px(k, None)?;
+                }
+                t = t.wrapping_add(dt as u64);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The Quake approach: the exact reciprocal ([`exact_u`]) every `N` pixels and at the span's last pixel, `W` linear
+/// in between. Interpolating `1/t` linearly over `h` pixels errs by at most `f'' h^2 / 8` with `f = 1/t`,
+/// `f'' = 2 (dt)^2 / t^3`: relative to `W`, at most `(h * |dt| / t_min)^2 / 4` (`t_min` the sub-span's smallest `t`),
+/// plus one unit of `2^-62` per pixel for the rounded step. No fixed bound: it grows with the square of how fast `t`
+/// changes, which is what the report measures. Spans not wholly in range take the exact reciprocal at every pixel.
+#[derive(Default)]
+pub struct Quake<const N: usize>;
+
+impl<const N: usize> Quake<N> {
+    /// The bound above for one span, relative to `W`: `(N |dt| / t_min)^2 / 4`, plus the rounding: half a unit of
+    /// `2^-62` at each exact point and under one unit per interpolated step, at most `N + 1` units, over
+    /// `u >= 2^62 / t >= 2^32` (`t <= 2^30`).
+    pub fn span_bound(t0: u64, dt: i64, n: usize) -> f64 {
+        let last = t0.wrapping_add((dt as u64).wrapping_mul(n as u64 - 1));
+        let d = N as f64 * dt.unsigned_abs() as f64 / t0.min(last) as f64;
+        d * d / 4.0 + (N + 1) as f64 / (1u64 << 32) as f64
+    }
+}
+
+impl<const N: usize> WSpan for Quake<N> {
+    const NAME: &'static str = if N == 8 {
+        "quake-8"
+    } else if N == 16 {
+        "quake-16"
+    } else {
+        "quake"
+    };
+    #[inline(always)]
+    fn walk<E>(
+        &mut self,
+        t0: u64,
+        dt: i64,
+        n: usize,
+        frac: u32,
+        lo: u64,
+        hi: u64,
+        mut px: impl FnMut(usize, Option<u64>) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let step = |k: usize| t0.wrapping_add((dt as u64).wrapping_mul(k as u64));
+        if !ends_in(t0, dt, n, lo, hi) {
+            for k in 0..n {
+                let t = step(k);
+                px(k, (t >= lo && t <= hi).then(|| exact_u(t, frac)))?;
+            }
+            return Ok(());
+        }
+        let mut k = 0;
+        let mut ua = exact_u(t0, frac);
+        while k < n {
+            let h = N.min(n - 1 - k);
+            if h == 0 {
+                px(k, Some(ua))?;
+                break;
+            }
+            let ub = exact_u(step(k + h), frac);
+            // u <= 2^62, so the difference and the running value fit i64.
+            let d = ub as i64 - ua as i64;
+            let s = if h == N && N.is_power_of_two() {
+                d >> N.trailing_zeros()
+            } else {
+                d / h as i64
+            };
+            let mut u = ua as i64;
+            for j in 0..h {
+                px(k + j, Some(u as u64))?;
+                u += s;
+            }
+            k += h;
+            ua = ub;
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

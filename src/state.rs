@@ -31,9 +31,9 @@ pub enum Compare {
 }
 
 impl Compare {
-    /// The comparison on two stored codes.
+    /// The comparison on two stored codes (of any width).
     #[inline(always)]
-    pub fn test(self, new: u16, stored: u16) -> bool {
+    pub fn test<T: PartialOrd>(self, new: T, stored: T) -> bool {
         match self {
             Compare::Never => false,
             Compare::Less => new < stored,
@@ -45,6 +45,21 @@ impl Compare {
             Compare::Always => true,
         }
     }
+}
+
+/// What the depth buffer holds, like seed 001_4caa61ee3442653f.txt's `D3DMRS_ZENABLE` (FALSE / TRUE / USEW).
+/// The format decides what it can store: W formats hold W, Z formats Z. Asking for W with a Z format falls back to Z
+/// (seed 002_84ba942b86c67763.txt's capability check: `USEW` if the device can, else `TRUE`), and the draw says so
+/// ([`crate::Resolved`]); asking for Z with a W format is an error. Without a depth buffer depth is off, whatever is
+/// asked (seed 001: depth buffering needs a depth buffer).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthMode {
+    /// No depth test, no depth write (`D3DZB_FALSE`).
+    Off,
+    /// Z buffering (`D3DZB_TRUE`).
+    Z,
+    /// W buffering (`D3DZB_USEW`).
+    W,
 }
 
 /// Which screen-space winding is dropped. Pixel y grows downwards, so "clockwise" is as seen on the display.
@@ -124,6 +139,8 @@ impl DepthRange {
 pub struct RenderState {
     /// The depth range; W outside it is not drawn.
     pub range: DepthRange,
+    /// Depth buffering asked for (see [`DepthMode`]).
+    pub mode: DepthMode,
     /// The depth comparison.
     pub compare: Compare,
     /// Whether passing pixels store their depth.
@@ -139,10 +156,11 @@ pub struct RenderState {
 }
 
 impl RenderState {
-    /// `Less`, depth write on, no culling, over `[w_near, w_far]`.
+    /// W buffering, `Less`, depth write on, no culling, over `[w_near, w_far]`.
     pub fn new(w_near: f32, w_far: f32) -> Result<Self, Error> {
         Ok(RenderState {
             range: DepthRange::new(w_near, w_far)?,
+            mode: DepthMode::W,
             compare: Compare::Less,
             depth_write: true,
             cull: Cull::None,

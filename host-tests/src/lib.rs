@@ -8,8 +8,10 @@
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::*;
 use embedded_graphics::primitives::Rectangle;
-use wraster::recip::SpanRecip;
-use wraster::{DepthBuffer, Error, Rasterizer, RenderState, Stats, Vertex};
+use wraster::format::{rz_of, z_of, DepthFormat};
+use wraster::packed::Input;
+use wraster::recip::{SpanRecip, WSpan};
+use wraster::{Codec, DepthBuffer, Error, Packed, Rasterizer, RenderState, Stats, Vertex};
 
 /// A colour framebuffer that counts writes per pixel and panics on any write outside it.
 #[derive(Clone, PartialEq, Eq, Debug)]
@@ -251,6 +253,97 @@ pub fn render<R: SpanRecip>(
         y0 += bh;
     }
     Ok((frame, depth, stats))
+}
+
+/// A random coordinate: mostly anywhere in and around the frame, sometimes on a pixel centre, sometimes on a
+/// sub-pixel tie (half-way between two 1/256 steps, which rounds to even).
+pub fn coord(rng: &mut Rng, extent: f64) -> f32 {
+    let v = rng.f(-0.3 * extent, 1.3 * extent);
+    match rng.bits() % 4 {
+        0 => (v.floor() + 0.5) as f32,
+        1 => ((v * 256.0).floor() / 256.0 + 1.0 / 512.0) as f32,
+        _ => v as f32,
+    }
+}
+
+/// A random triangle around a `W x H` frame (the tests' 96 x 64): sizes from sub-pixel slivers to much larger than
+/// the frame, both windings, depths log-uniform in `[wmin, wmax)`.
+pub fn random_tri(rng: &mut Rng, wmin: f64, wmax: f64) -> [Vertex<Rgb565>; 3] {
+    let c = Rgb565::new(
+        (rng.bits() % 32) as u8,
+        (rng.bits() % 64) as u8,
+        (rng.bits() % 32) as u8,
+    );
+    let kind = rng.bits() % 4;
+    let (x, y) = (coord(rng, 96.0), coord(rng, 64.0));
+    let spread = match kind {
+        0 => 0.5,
+        1 => 4.0,
+        2 => 30.0,
+        _ => 200.0,
+    };
+    let mut v = [Vertex::new(x, y, rng.log(wmin, wmax) as f32, c); 3];
+    for q in v.iter_mut().skip(1) {
+        q.x = x + rng.f(-spread, spread) as f32;
+        q.y = y + rng.f(-spread, spread) as f32;
+        q.rhw = 1.0 / rng.log(wmin, wmax) as f32;
+    }
+    if kind == 0 && rng.bits().is_multiple_of(2) {
+        // a sliver: the third vertex nearly on the line of the first two
+        let s = rng.f(0.0, 1.0) as f32;
+        v[2].x = v[0].x + s * (v[1].x - v[0].x) + 1.0 / 512.0;
+        v[2].y = v[0].y + s * (v[1].y - v[0].y);
+    }
+    v
+}
+
+/// Renders `tris` into a `w x h` frame and a whole-frame buffer of format `F` (cleared to the far plane) with
+/// strategy `R`; returns the frame, every pixel's code and the summed stats.
+pub fn render_format<F: Codec, R: WSpan>(
+    tris: &[[Vertex<Rgb565>; 3]],
+    state: RenderState,
+    w: u16,
+    h: u16,
+) -> Result<(Frame, Vec<u32>, Stats), Error> {
+    let mut frame = Frame::new(w as u32, h as u32);
+    let mut bytes = vec![0u8; w as usize * h as usize * F::BYTES];
+    let mut buf = Packed::<F>::new(&mut bytes, w, h)?;
+    buf.clear(&state.range);
+    let mut r = Rasterizer::<R>::new(state);
+    let mut stats = Stats::default();
+    for t in tris {
+        stats += r.draw_format(&mut frame, Some(&mut buf), t)?;
+    }
+    let codes = bytes.chunks_exact(F::BYTES).map(F::unpack).collect();
+    Ok((frame, codes, stats))
+}
+
+/// The exact value format `F` stores for eye depth `d` (what [`DepthFormat::fraction`] decodes a code to): `d / f`
+/// for W formats, D3D Z, reversed Z, or the linear-Z trick's `(d - n) / (f - n)`. Computed here, in f64, from the
+/// formulas, not from the format's code.
+pub fn exact_fraction<F: Codec>(d: f64, n: f64, f: f64) -> f64 {
+    match (F::INPUT, F::REVERSED) {
+        (Input::W, _) => d / f,
+        (Input::Z, false) => z_of(d, n, f),
+        (Input::Z, true) => rz_of(d, n, f),
+        (Input::LinearZ, _) => (d - n) / (f - n),
+    }
+}
+
+/// Half the larger distance from `code`'s value to its neighbours' (the rounding a correct encoder can add).
+pub fn half_step<F: DepthFormat>(code: u32, n: f64, f: f64) -> f64 {
+    let v = F::fraction(code, n, f);
+    let up = if code < F::MAX_CODE {
+        (F::fraction(code + 1, n, f) - v).abs()
+    } else {
+        0.0
+    };
+    let down = if code > 0 {
+        (v - F::fraction(code - 1, n, f)).abs()
+    } else {
+        0.0
+    };
+    up.max(down) / 2.0
 }
 
 /// A small xorshift64 generator for reproducible tests.

@@ -2,53 +2,12 @@
 
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::*;
-use host_tests::{reference_frame, reference_tri, render, Frame, Rng};
+use host_tests::{random_tri, reference_frame, reference_tri, render, Frame, Rng};
 use wraster::recip::{PerPixel, PrevPixel, SpanRecip};
 use wraster::{Compare, DepthBuffer, Rasterizer, RenderState, Vertex, W16_FAR};
 
 const W: u16 = 96;
 const H: u16 = 64;
-
-/// A random coordinate: mostly anywhere in and around the frame, sometimes on a pixel centre, sometimes on a
-/// sub-pixel tie (half-way between two 1/256 steps, which rounds to even).
-fn coord(rng: &mut Rng, extent: f64) -> f32 {
-    let v = rng.f(-0.3 * extent, 1.3 * extent);
-    match rng.bits() % 4 {
-        0 => (v.floor() + 0.5) as f32,
-        1 => ((v * 256.0).floor() / 256.0 + 1.0 / 512.0) as f32,
-        _ => v as f32,
-    }
-}
-
-/// A random triangle: sizes from sub-pixel slivers to much larger than the frame, both windings.
-fn random_tri(rng: &mut Rng, wmin: f64, wmax: f64) -> [Vertex<Rgb565>; 3] {
-    let c = Rgb565::new(
-        (rng.bits() % 32) as u8,
-        (rng.bits() % 64) as u8,
-        (rng.bits() % 32) as u8,
-    );
-    let kind = rng.bits() % 4;
-    let (x, y) = (coord(rng, W as f64), coord(rng, H as f64));
-    let spread = match kind {
-        0 => 0.5,
-        1 => 4.0,
-        2 => 30.0,
-        _ => 200.0,
-    };
-    let mut v = [Vertex::new(x, y, rng.log(wmin, wmax) as f32, c); 3];
-    for q in v.iter_mut().skip(1) {
-        q.x = x + rng.f(-spread, spread) as f32;
-        q.y = y + rng.f(-spread, spread) as f32;
-        q.rhw = 1.0 / rng.log(wmin, wmax) as f32;
-    }
-    if kind == 0 && rng.bits().is_multiple_of(2) {
-        // a sliver: the third vertex nearly on the line of the first two
-        let s = rng.f(0.0, 1.0) as f32;
-        v[2].x = v[0].x + s * (v[1].x - v[0].x) + 1.0 / 512.0;
-        v[2].y = v[0].y + s * (v[1].y - v[0].y);
-    }
-    v
-}
 
 struct Tally {
     pixels: u64,

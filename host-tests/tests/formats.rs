@@ -1,0 +1,339 @@
+//! Rendering into every depth format (src/packed.rs) against the f64 reference and the formats' definitions;
+//! depth modes and seed 002's capability check; the linear-Z trick inside triangles.
+
+use embedded_graphics::pixelcolor::Rgb565;
+use embedded_graphics::prelude::*;
+use host_tests::{
+    exact_fraction, half_step, random_tri, reference_tri, render, render_format, Frame, Rng,
+};
+use wraster::format::{
+    DepthFormat, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F,
+};
+use wraster::packed::{resolve, Input};
+use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, Quake, SpanRecip, WSpan};
+use wraster::scenes::{Scene, HEIGHT, WIDTH};
+use wraster::{Codec, Compare, DepthMode, Error, Packed, Rasterizer, RenderState, Vertex};
+
+const W: u16 = 96;
+const H: u16 = 64;
+
+/// The W16 codes and the colours of the packed path equal the lean path's (`Rasterizer::draw`), for every scene, with
+/// both per-pixel strategies: the same `T`, reciprocal and rounding, so the same codes, bit for bit.
+#[test]
+fn packed_w16_equals_the_lean_path() {
+    fn check<R: SpanRecip>() {
+        for scene in Scene::ALL {
+            let (n, f) = scene.depth_range();
+            let tris: Vec<_> = scene.tris().collect();
+            let state = RenderState::new(n, f).unwrap();
+            let (f1, d1, s1) = render::<R>(&tris, state, WIDTH, HEIGHT, HEIGHT).unwrap();
+            let (f2, d2, s2) = render_format::<W16, R>(&tris, state, WIDTH, HEIGHT).unwrap();
+            assert_eq!(s1, s2, "{} {}", scene.name(), R::NAME);
+            assert!(f1 == f2, "{} {}: colours differ", scene.name(), R::NAME);
+            assert!(
+                d1.iter().zip(&d2).all(|(a, b)| *a as u32 == *b),
+                "{} {}: codes differ",
+                scene.name(),
+                R::NAME
+            );
+        }
+    }
+    check::<PerPixel<DefaultRecip>>();
+    check::<PrevPixel>();
+}
+
+/// Bounds of the value a pixel stores before rounding to a code, relative (`rel`, times the value) and absolute
+/// (`abs`), for the default reciprocal and depth ranges up to `f/n = 1e5`:
+/// - `T` (the plane of `t = f/W`) errs by at most `(1 + k + l) / 2` units of `2^-F` at `k` columns and `l` rows from
+///   its reference pixel (src/raster.rs), `F = 61 - bits(floor(t_max)) >= 44` for `t_max <= 1e5 < 2^17`, and
+///   `k + l < 2^10` here, so below `2^-34` of `t >= 1`, relative;
+/// - W formats: the reciprocal (`PerPixel<DefaultRecip>::MAX_REL_ERROR`), plus `2^-31` for the top 32 bits of `u`
+///   the float formats multiply by `W_far`, plus the `T` error: all relative;
+/// - Z formats: `rz = (t - 1) n / (f - n)` with `n / (f - n)` truncated to 32 bits (`2^-31` relative) and `T`'s error
+///   `2^-34 t` times `n / (f - n)`, absolute `2^-34 f / (f - n) <= 2^-33` for `f >= 2n`; `Z = 1 - rz` has the same
+///   absolute error, reversed Z the same relative and absolute parts.
+fn value_bound<F: Codec>(v: f64) -> f64 {
+    let t_err = 2f64.powi(-34);
+    match F::INPUT {
+        // The 24-bit float formats are defined (seed 003) as the f32 with its low byte rounded off: a double rounding,
+        // which adds up to half an f32 step, 2^-24 relative.
+        Input::W if F::BYTES == 3 => {
+            v * (PerPixel::<DefaultRecip>::MAX_REL_ERROR + 2f64.powi(-31) + t_err + 2f64.powi(-24))
+        }
+        Input::W => v * (PerPixel::<DefaultRecip>::MAX_REL_ERROR + 2f64.powi(-31) + t_err),
+        // the relative part is of rz: 1 - Z for Z, the value itself for reversed Z
+        _ => {
+            let rz = if F::REVERSED { v } else { 1.0 - v };
+            rz * 2f64.powi(-31) + 2f64.powi(-33)
+        }
+    }
+}
+
+/// Every covered, in-range pixel of random triangles (each drawn alone into a cleared buffer with `Always`) holds a
+/// code whose value is within the derived bound of the exact value plus half a step (round to nearest), and the
+/// packed path covers exactly the reference's pixels.
+fn within_bound<F: Codec>() {
+    let mut rng = Rng(0x5EED_F0F0 ^ F::BYTES as u64 ^ (F::MAX_CODE as u64) << 8);
+    let (mut pixels, mut exact, mut worst) = (0u64, 0u64, 0f64);
+    for (n, f) in [(10.0f32, 1000.0f32), (1.0, 1e4), (0.1, 1e4), (1.0, 1e5)] {
+        let (nd, fd) = (n as f64, f as f64);
+        let mut state = RenderState::new(n, f).unwrap();
+        state.compare = Compare::Always;
+        for _ in 0..300 {
+            let tri = random_tri(&mut rng, nd * 0.8, fd * 1.1);
+            let Some(refpx) =
+                reference_tri(&tri.map(|q| (q.x, q.y, q.rhw)), n, f, W as i32, 0..H as i32)
+            else {
+                continue;
+            };
+            let (_, codes, stats) =
+                render_format::<F, PerPixel<DefaultRecip>>(&[tri], state, W, H).unwrap();
+            let drawn = refpx.iter().filter(|p| p.in_range).count() as u32;
+            assert_eq!(stats.written, drawn, "{} coverage {tri:?}", F::NAME);
+            for p in refpx.iter().filter(|p| p.in_range) {
+                let d = fd / p.t;
+                let code = codes[(p.y as u32 * W as u32 + p.x as u32) as usize];
+                let want = exact_fraction::<F>(d, nd, fd);
+                let got = F::fraction(code, nd, fd);
+                let err = (got - want).abs();
+                let bound = value_bound::<F>(want) + half_step::<F>(code, nd, fd);
+                assert!(
+                    err <= bound,
+                    "{} n={n} f={f} d={d}: value {got} vs exact {want}, err {err:e} > bound {bound:e}",
+                    F::NAME
+                );
+                pixels += 1;
+                exact += (code == F::encode(d, nd, fd)) as u64;
+                worst = worst.max(err / bound);
+            }
+        }
+    }
+    println!(
+        "{}: {pixels} px, {:.4}% equal to the f64 encode, worst error {:.3} of its bound",
+        F::NAME,
+        100.0 * exact as f64 / pixels as f64,
+        worst
+    );
+    assert!(pixels > 10_000);
+}
+
+#[test]
+fn w16_within_bound() {
+    within_bound::<W16>();
+}
+#[test]
+fn w16f_within_bound() {
+    within_bound::<W16F>();
+}
+#[test]
+fn w24f_within_bound() {
+    within_bound::<W24F>();
+}
+#[test]
+fn w24f_scaled_within_bound() {
+    within_bound::<W24FScaled>();
+}
+#[test]
+fn w32f_within_bound() {
+    within_bound::<W32F>();
+}
+#[test]
+fn z16_within_bound() {
+    within_bound::<Z16>();
+}
+#[test]
+fn z24_within_bound() {
+    within_bound::<Z24>();
+}
+#[test]
+fn z32f_within_bound() {
+    within_bound::<Z32F>();
+}
+#[test]
+fn rz32f_within_bound() {
+    within_bound::<RZ32F>();
+}
+
+/// Seed 004's linear-Z trick stores `(d - n) / (f - n)` at the vertices and interpolates it linearly in screen space,
+/// where `1/d` is what is linear. With screen barycentrics `l_i`, the stored depth is `sum l_i d_i` against the true
+/// `1 / sum (l_i / d_i)`, and by Kantorovich's inequality their ratio is at most `(r + 1)^2 / (4r)`, `r = d_max/d_min`:
+/// relative error at most `(r - 1)^2 / (4r)` (seed_numbers.rs checks the one-dimensional case against the seed).
+/// Every pixel of a slanted quad stays inside that bound (plus the rounding and the `T` error of the bound above),
+/// always towards far, and the error is real: above a quarter of the bound somewhere, hundreds of codes.
+#[test]
+fn linear_z_trick_errs_inside_triangles_within_kantorovich() {
+    let (n, f) = (10.0f32, 10000.0f32);
+    let (nd, fd) = (n as f64, f as f64);
+    let c = Rgb565::GREEN;
+    let quad = [
+        (2.0, 2.0, 20.0),
+        (94.0, 2.0, 20.0),
+        (94.0, 62.0, 2000.0),
+        (2.0, 62.0, 2000.0),
+    ];
+    let v = |k: usize| Vertex::new(quad[k].0, quad[k].1, quad[k].2, c);
+    let tris = [[v(0), v(1), v(2)], [v(0), v(2), v(3)]];
+    let state = RenderState::new(n, f).unwrap();
+    let (_, codes, _) = render_format::<LZ16, PerPixel<DefaultRecip>>(&tris, state, W, H).unwrap();
+    let (mut max_rel, mut max_codes, mut px) = (0f64, 0i64, 0);
+    for tri in &tris {
+        let depths = tri.map(|q| 1.0 / q.rhw as f64);
+        let r = depths.iter().cloned().fold(0.0, f64::max)
+            / depths.iter().cloned().fold(f64::MAX, f64::min);
+        let kant = (r - 1.0).powi(2) / (4.0 * r);
+        for p in
+            reference_tri(&tri.map(|q| (q.x, q.y, q.rhw)), n, f, W as i32, 0..H as i32).unwrap()
+        {
+            let d = fd / p.t;
+            let code = codes[(p.y as u32 * W as u32 + p.x as u32) as usize];
+            let stored = LZ16::fraction(code, nd, fd);
+            let truth = (d - nd) / (fd - nd);
+            // the stored linear depth's relative error, as a depth: (n + s (f - n)) / d - 1
+            let rel = (nd + stored * (fd - nd)) / d - 1.0;
+            let slack = (half_step::<LZ16>(code, nd, fd) + 2f64.powi(-33)) * (fd - nd) / d;
+            assert!(
+                rel <= kant + slack && rel >= -slack,
+                "d={d}: rel {rel} vs bound {kant}"
+            );
+            max_rel = max_rel.max(rel / kant);
+            max_codes = max_codes.max(code as i64 - LZ16::encode(d, nd, fd) as i64);
+            let _ = truth;
+            px += 1;
+        }
+    }
+    println!("linear-Z trick: {px} px, worst {max_rel:.3} of the Kantorovich bound, {max_codes} codes too far");
+    assert!(max_rel > 0.25 && max_codes > 100);
+}
+
+/// Seed 002's capability check and seed 001's "no depth buffer, no depth".
+#[test]
+fn modes_fall_back_and_depth_is_off_without_a_buffer() {
+    use DepthMode::{Off, Z};
+    const WM: DepthMode = DepthMode::W;
+    let r = |m, has| resolve::<Z16>(m, has).map(|r| (r.mode, r.fell_back));
+    assert_eq!(
+        r(WM, true),
+        Ok((Z, true)),
+        "W asked, Z format: Z, and it says so"
+    );
+    assert_eq!(r(Z, true), Ok((Z, false)));
+    assert_eq!(r(Off, true), Ok((Off, false)));
+    assert_eq!(r(WM, false), Ok((Off, false)), "no buffer: off");
+    assert_eq!(r(Z, false), Ok((Off, false)));
+    assert_eq!(resolve::<W16F>(WM, true).map(|r| r.mode), Ok(WM));
+    assert_eq!(resolve::<W16F>(Z, true), Err(Error::ZWithWFormat));
+    assert_eq!(resolve::<LZ16>(WM, true).map(|r| r.fell_back), Ok(true));
+
+    // Without a buffer every covered pixel is written, in drawing order (the later triangle wins), whatever the mode.
+    let near = [
+        Vertex::new(0.0, 0.0, 20.0, Rgb565::RED),
+        Vertex::new(96.0, 0.0, 20.0, Rgb565::RED),
+        Vertex::new(0.0, 64.0, 20.0, Rgb565::RED),
+    ];
+    let far = near.map(|q| Vertex::new(q.x, q.y, 900.0, Rgb565::BLUE));
+    for mode in [Off, Z, WM] {
+        let mut state = RenderState::new(10.0, 1000.0).unwrap();
+        state.mode = mode;
+        let mut r = Rasterizer::<PerPixel<DefaultRecip>>::new(state);
+        let mut frame = Frame::new(W as u32, H as u32);
+        let a = r.draw_format::<W16, _>(&mut frame, None, &near).unwrap();
+        let b = r.draw_format::<W16, _>(&mut frame, None, &far).unwrap();
+        assert_eq!((a.written, b.written), (a.fragments, b.fragments));
+        assert!(a.written > 2000);
+        assert!(
+            frame.px.iter().all(|&c| c != Rgb565::RED),
+            "{mode:?}: depth must be off"
+        );
+        if mode == Z {
+            continue; // Z with a W16 buffer is refused: below
+        }
+        // With a buffer and mode Off, the buffer is untouched and everything passes.
+        let mut bytes = vec![0u8; W as usize * H as usize * 2];
+        let mut buf = Packed::<W16>::new(&mut bytes, W, H).unwrap();
+        buf.clear(&state.range);
+        let s = r.draw_format(&mut frame, Some(&mut buf), &near).unwrap();
+        let t = r.draw_format(&mut frame, Some(&mut buf), &far).unwrap();
+        if mode == Off {
+            assert_eq!((s.written, t.written), (s.fragments, t.fragments));
+            assert!(
+                bytes.iter().all(|&b| b == 0xff),
+                "mode Off must not write depth"
+            );
+        } else if mode == WM {
+            assert_eq!(t.written, 0, "W: the far triangle is hidden");
+        }
+    }
+    // Z asked with a W format is an error, and nothing is drawn.
+    let mut state = RenderState::new(10.0, 1000.0).unwrap();
+    state.mode = Z;
+    let mut r = Rasterizer::<PerPixel<DefaultRecip>>::new(state);
+    let mut frame = Frame::new(W as u32, H as u32);
+    let mut bytes = vec![0u8; W as usize * H as usize * 2];
+    let mut buf = Packed::<W16>::new(&mut bytes, W, H).unwrap();
+    assert_eq!(
+        r.draw_format(&mut frame, Some(&mut buf), &near),
+        Err(Error::ZWithWFormat)
+    );
+    assert_eq!(frame.writes.iter().sum::<u32>(), 0);
+    let mut d16 = vec![0u16; W as usize * H as usize];
+    let mut lean = wraster::DepthBuffer::new(&mut d16, W, H).unwrap();
+    assert_eq!(
+        r.draw(&mut frame, &mut lean, &near),
+        Err(Error::ZWithWFormat)
+    );
+}
+
+/// Two triangles 50 units apart, drawn in both orders: with `Less`, the nearer one is visible in every format,
+/// including reversed Z (whose comparison is evaluated reversed) and with every W strategy.
+#[test]
+fn less_keeps_the_nearest_in_every_format() {
+    fn check<F: Codec, R: WSpan>() {
+        let mk = |w: f32, c| {
+            [
+                Vertex::new(4.0, 4.0, w, c),
+                Vertex::new(90.0, 8.0, w * 1.5, c),
+                Vertex::new(10.0, 60.0, w * 1.2, c),
+            ]
+        };
+        let (a, b) = (mk(100.0, Rgb565::RED), mk(150.0, Rgb565::BLUE));
+        let state = RenderState::new(1.0, 1000.0).unwrap();
+        for order in [[a, b], [b, a]] {
+            let (frame, _, _) = render_format::<F, R>(&order, state, W, H).unwrap();
+            let red = frame.px.iter().filter(|&&c| c == Rgb565::RED).count();
+            assert!(red > 2000, "{} {}", F::NAME, R::NAME);
+            assert!(
+                frame.px.iter().all(|&c| c != Rgb565::BLUE),
+                "{} {}: the far one shows",
+                F::NAME,
+                R::NAME
+            );
+        }
+    }
+    check::<W16, PerPixel<DefaultRecip>>();
+    check::<W16F, PrevPixel>();
+    check::<W24F, Quake<8>>();
+    check::<W24FScaled, Quake<16>>();
+    check::<W32F, PerPixel<DefaultRecip>>();
+    check::<Z16, PerPixel<DefaultRecip>>();
+    check::<Z24, PerPixel<DefaultRecip>>();
+    check::<Z32F, PerPixel<DefaultRecip>>();
+    check::<RZ32F, PerPixel<DefaultRecip>>();
+    check::<LZ16, PerPixel<DefaultRecip>>();
+}
+
+/// A packed buffer of the wrong size is refused; bands of a packed buffer cover exactly their rows.
+#[test]
+fn packed_buffers_check_their_size() {
+    let mut b = vec![0u8; 10];
+    assert!(matches!(
+        Packed::<Z24>::new(&mut b, 2, 2),
+        Err(Error::BufferSize {
+            expected: 12,
+            actual: 10
+        })
+    ));
+    let mut b = vec![0u8; 12];
+    let buf = Packed::<Z24>::new(&mut b, 2, 2).unwrap();
+    assert_eq!(buf.get(1, 1), Some(0));
+    assert_eq!(buf.get(2, 1), None);
+}

@@ -1,0 +1,513 @@
+//! Depth buffers of any [`DepthFormat`], packed 2, 3 or 4 bytes a pixel, and the span loop that fills them.
+//!
+//! Every format goes through the same edge walk and the same screen-linear `T = t 2^F`, `t = W_far / W`
+//! (see [`crate::raster`]). What a pixel stores is computed from it in integers, never in f64:
+//! - W formats ([`Input::W`]) take `u = W / W_far` in Q0.62 from the rasterizer's `W` strategy (a per-pixel reciprocal
+//!   or [`crate::recip::Quake`]);
+//! - Z formats ([`Input::Z`]) take D3D's `[0, 1]` Z, which is affine in `1/W` and so needs no reciprocal:
+//!   `Z = 1 - rz`, `rz = (t - 1) n / (f - n)` (the reversed Z), in Q0.60, from `T` with one multiply;
+//! - the linear-Z trick ([`Input::LinearZ`], seed 004_7efaf595ce119344.txt's `z * w / far`) computes each vertex's
+//!   `(W - n) / (f - n)` exactly and interpolates it linearly in screen space, as the hardware interpolates any
+//!   vertex z: right at the vertices, wrong inside (the error the seed does not mention, shown by the tests).
+//!
+//! The W16 buffer of [`crate::DepthBuffer`] has its own lean loop ([`crate::Rasterizer::draw`]); this one serves every
+//! format with every strategy, and gives the same W16 codes (a test checks it).
+
+use core::marker::PhantomData;
+
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::pixelcolor::PixelColor;
+
+use crate::fixed::{div_u128, split};
+use crate::format::{DepthFormat, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
+#[cfg(feature = "bias")]
+use crate::raster::slope_bias;
+use crate::raster::{Plane, Runs, Stats, Vertex};
+#[cfg(feature = "bias")]
+use crate::recip::exact_u;
+use crate::recip::WSpan;
+use crate::state::{DepthMode, DepthRange};
+use crate::{Error, Rasterizer};
+
+/// What a format's code is computed from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Input {
+    /// `u = W / W_far`, Q0.62 (`2^62` at the far plane).
+    W,
+    /// D3D Z of the pixel's `1/W`, Q0.60 (`2^60` at the far plane).
+    Z,
+    /// The linear-Z trick's value, interpolated linearly in screen space from the vertices, Q0.60.
+    LinearZ,
+}
+
+/// A format the rasterizer can store into: the integer encoder of [`DepthFormat`]'s f64 definition.
+pub trait Codec: DepthFormat {
+    /// What the code is computed from.
+    const INPUT: Input;
+    /// Nearer is a larger code (reversed Z): comparisons are evaluated with their operands swapped, so `Less` still
+    /// keeps the nearest surface.
+    const REVERSED: bool = false;
+    /// The code of `q` (in [`Codec::INPUT`]'s units, at most its far-plane value) with `W_far = far.0 * 2^far.1`.
+    fn code(q: u64, far: (u32, i32)) -> u32;
+    /// The code of the far plane, which a cleared buffer holds.
+    fn far_code(far: (u32, i32)) -> u32 {
+        Self::code(Self::far_q(), far)
+    }
+    /// The far plane in [`Codec::INPUT`]'s units.
+    fn far_q() -> u64 {
+        match Self::INPUT {
+            Input::W => 1 << 62,
+            Input::Z | Input::LinearZ => 1 << 60,
+        }
+    }
+}
+
+/// `round(q * max / 2^frac)` exactly.
+#[inline(always)]
+fn unorm_code(q: u64, frac: u32, max: u32) -> u32 {
+    (((q as u128 * max as u128) + (1u128 << (frac - 1))) >> frac).min(max as u128) as u32
+}
+
+/// The bits of the positive value `p * 2^e2` in an IEEE-style float with an 8-bit exponent (bias 127) and `mbits`
+/// mantissa bits, rounded to nearest (ties up); 0 for `p = 0`. The value must be in the normal range.
+#[inline(always)]
+fn float_bits(p: u64, e2: i32, mbits: u32) -> u32 {
+    if p == 0 {
+        return 0;
+    }
+    let b = 63 - p.leading_zeros() as i32;
+    let mut e = b + e2;
+    let mut m = if b > mbits as i32 {
+        let sh = (b - mbits as i32) as u32;
+        ((p as u128 + (1u128 << (sh - 1))) >> sh) as u64
+    } else {
+        p << (mbits as i32 - b)
+    };
+    if m >> (mbits + 1) != 0 {
+        m >>= 1;
+        e += 1;
+    }
+    (((e + 127) as u32) << mbits) | (m as u32 & ((1 << mbits) - 1))
+}
+
+/// `W` itself, as `(p, e2)` with `W = p * 2^e2`: `u / 2^62 * W_far`, from the top 32 bits of the normalised `u`
+/// (relative error below `2^-31`; `u > 0`).
+#[inline(always)]
+fn w_of(u: u64, far: (u32, i32)) -> (u64, i32) {
+    let lz = u.leading_zeros();
+    (
+        ((u << lz) >> 32) * far.0 as u64,
+        far.1 - 62 + 32 - lz as i32,
+    )
+}
+
+impl Codec for W16 {
+    const INPUT: Input = Input::W;
+    #[inline(always)]
+    fn code(u: u64, _far: (u32, i32)) -> u32 {
+        unorm_code(u, 62, 0xffff)
+    }
+}
+
+impl Codec for W16F {
+    const INPUT: Input = Input::W;
+    /// `v = 256 u / 2^62 = u / 2^54`: denormal below `2^-6` (`u < 2^48`), `round(v / 2^-18)`; else exponent
+    /// `floor(log2 v) + 7` and 12 mantissa bits rounded (a carry moves to the next exponent, as in the f64 encode).
+    #[inline(always)]
+    fn code(u: u64, _far: (u32, i32)) -> u32 {
+        if u < 1 << 48 {
+            return ((u + (1 << 35)) >> 36) as u32;
+        }
+        let b = 63 - u.leading_zeros();
+        let sh = b - 12;
+        let m = (u + (1 << (sh - 1))) >> sh; // [4096, 8192]
+        (((b as i32 - 54 + 7) as u32) << 12) + (m as u32 - 4096)
+    }
+}
+
+impl Codec for W24F {
+    const INPUT: Input = Input::W;
+    /// The f32 of `W`, then its low byte rounded off (the double rounding of the f64 definition).
+    #[inline(always)]
+    fn code(u: u64, far: (u32, i32)) -> u32 {
+        let (p, e) = w_of(u, far);
+        (float_bits(p, e, 23) + 0x80) >> 8
+    }
+}
+
+impl Codec for W24FScaled {
+    const INPUT: Input = Input::W;
+    /// `W / W_far * 2^127 = u * 2^65`.
+    #[inline(always)]
+    fn code(u: u64, _far: (u32, i32)) -> u32 {
+        (float_bits(u, 65, 23) + 0x80) >> 8
+    }
+}
+
+impl Codec for W32F {
+    const INPUT: Input = Input::W;
+    #[inline(always)]
+    fn code(u: u64, far: (u32, i32)) -> u32 {
+        let (p, e) = w_of(u, far);
+        float_bits(p, e, 23)
+    }
+}
+
+impl Codec for Z16 {
+    const INPUT: Input = Input::Z;
+    #[inline(always)]
+    fn code(z: u64, _far: (u32, i32)) -> u32 {
+        unorm_code(z, 60, 0xffff)
+    }
+}
+
+impl Codec for Z24 {
+    const INPUT: Input = Input::Z;
+    #[inline(always)]
+    fn code(z: u64, _far: (u32, i32)) -> u32 {
+        unorm_code(z, 60, 0xff_ffff)
+    }
+}
+
+impl Codec for Z32F {
+    const INPUT: Input = Input::Z;
+    #[inline(always)]
+    fn code(z: u64, _far: (u32, i32)) -> u32 {
+        float_bits(z, -60, 23)
+    }
+}
+
+impl Codec for RZ32F {
+    const INPUT: Input = Input::Z;
+    const REVERSED: bool = true;
+    #[inline(always)]
+    fn code(z: u64, _far: (u32, i32)) -> u32 {
+        float_bits((1u64 << 60) - z.min(1 << 60), -60, 23)
+    }
+}
+
+impl Codec for LZ16 {
+    const INPUT: Input = Input::LinearZ;
+    #[inline(always)]
+    fn code(z: u64, _far: (u32, i32)) -> u32 {
+        unorm_code(z, 60, 0xffff)
+    }
+}
+
+/// `n / (f - n)` as `k / 2^s` with `k` in `[2^31, 2^33)` (truncated: relative error below `2^-31`), for the reversed
+/// Z `rz = (t - 1) n / (f - n)`.
+#[derive(Clone, Copy)]
+pub(crate) struct ZConst {
+    k: u64,
+    s: i32,
+}
+
+impl ZConst {
+    pub(crate) fn new(range: &DepthRange) -> Self {
+        // Both are positive and finite (checked by DepthRange).
+        let (_, nm, ne) = split(range.near()).unwrap_or((false, 1, 0));
+        let (_, fm, fe) = split(range.far()).unwrap_or((false, 2, 0));
+        let e = ne.min(fe);
+        // f / n <= 2^30 and both mantissas are below 2^24, so the aligned values stay below 2^(24 + 30 + 24).
+        let nv = (nm as u128) << (ne - e).min(100);
+        let fv = (fm as u128) << (fe - e).min(100);
+        let d = (fv - nv).max(1);
+        let bits = |v: u128| 128 - v.leading_zeros() as i32;
+        let s = 32 + bits(d) - bits(nv);
+        let k = if s >= 0 {
+            (nv << s as u32) / d
+        } else {
+            (nv >> (-s) as u32) / d
+        };
+        ZConst { k: k as u64, s }
+    }
+    /// `rz * 2^60` of `T = t 2^frac` (signed: negative beyond the far plane), saturated to `[-2^62, 2^62]`.
+    #[inline(always)]
+    pub(crate) fn rz60(&self, t: u64, frac: u32) -> i64 {
+        let d = t as i128 - (1i128 << frac);
+        let p = d * self.k as i128; // |d| < 2^62, k < 2^33
+        let sh = self.s + frac as i32 - 60;
+        let v = if sh >= 0 {
+            p >> sh.min(127)
+        } else {
+            p << (-sh).min(40)
+        };
+        v.clamp(-(1 << 62), 1 << 62) as i64
+    }
+    /// D3D Z in Q0.60 of a pixel in range (`t` in `[1, f/n]`).
+    #[inline(always)]
+    pub(crate) fn z60(&self, t: u64, frac: u32) -> u64 {
+        ((1i64 << 60) - self.rz60(t, frac)).clamp(0, 1 << 60) as u64
+    }
+}
+
+/// The linear-Z trick's value `(W - n) / (f - n) = Z * u` at a vertex (exact `u`), Q0.60, saturated to `+-2^61` so
+/// vertices beyond the range still give a plane (pixels outside the range are not drawn).
+fn linear_z60(zc: &ZConst, t: i64, frac: u32) -> i64 {
+    let t = t.max(1) as u64;
+    let z = (1i128 << 60) - zc.rz60(t, frac) as i128;
+    let u = div_u128((1u128 << (62 + frac).min(125)) + (t as u128 >> 1), t).min(1 << 100) as i128;
+    ((z * u) >> 62).clamp(-(1 << 61), 1 << 61) as i64
+}
+
+/// A borrowed depth buffer of format `F`: `width * height` pixels of `F::BYTES` bytes, little-endian, row-major,
+/// covering frame rows `y0 ..`. The layout the frame's pixel `(x, y)` has is bytes `((y - y0) * width + x) * BYTES ..`.
+pub struct Packed<'a, F> {
+    data: &'a mut [u8],
+    width: u16,
+    height: u16,
+    y0: i32,
+    _f: PhantomData<F>,
+}
+
+impl<'a, F: Codec> Packed<'a, F> {
+    /// A whole-frame buffer; `data.len()` must be `width * height * F::BYTES`.
+    pub fn new(data: &'a mut [u8], width: u16, height: u16) -> Result<Self, Error> {
+        Self::band(data, width, 0, height)
+    }
+    /// A band of `height` rows from frame row `y0`; `data.len()` must be `width * height * F::BYTES`.
+    pub fn band(data: &'a mut [u8], width: u16, y0: i32, height: u16) -> Result<Self, Error> {
+        let expected = width as usize * height as usize * F::BYTES;
+        if data.len() != expected || width == 0 || height == 0 {
+            return Err(Error::BufferSize {
+                expected,
+                actual: data.len(),
+            });
+        }
+        Ok(Packed {
+            data,
+            width,
+            height,
+            y0,
+            _f: PhantomData,
+        })
+    }
+    /// Sets every pixel to the far plane's code for `range` (0 for reversed Z).
+    pub fn clear(&mut self, range: &DepthRange) {
+        let (_, fm, fe) = split(range.far()).unwrap_or((false, 0, 0));
+        let far = F::far_code((fm, fe));
+        for px in self.data.chunks_exact_mut(F::BYTES) {
+            F::pack(far, px);
+        }
+    }
+    /// Frame width in pixels.
+    pub fn width(&self) -> u16 {
+        self.width
+    }
+    /// Rows held.
+    pub fn height(&self) -> u16 {
+        self.height
+    }
+    /// First frame row held.
+    pub fn y0(&self) -> i32 {
+        self.y0
+    }
+    /// The packed bytes.
+    pub fn data(&self) -> &[u8] {
+        self.data
+    }
+    /// The code at frame pixel `(x, y)`, if it is in this buffer.
+    pub fn get(&self, x: i32, y: i32) -> Option<u32> {
+        let r = y.checked_sub(self.y0)?;
+        if x < 0 || x >= self.width as i32 || r < 0 || r >= self.height as i32 {
+            return None;
+        }
+        let k = (r as usize * self.width as usize + x as usize) * F::BYTES;
+        Some(F::unpack(&self.data[k..k + F::BYTES]))
+    }
+    fn row_mut(&mut self, y: i32, lo: i32, hi: i32) -> &mut [u8] {
+        let r = (y - self.y0) as usize * self.width as usize;
+        &mut self.data[(r + lo as usize) * F::BYTES..(r + hi as usize) * F::BYTES]
+    }
+}
+
+/// The depth buffering a draw gets after seed 002's capability check (see [`DepthMode`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Resolved {
+    /// What the draw does.
+    pub mode: DepthMode,
+    /// W was asked for, the format stores Z: Z is used instead.
+    pub fell_back: bool,
+}
+
+/// Seed 002's capability check for format `F`: W where asked and `F` stores W, Z when `F` stores Z (falling back
+/// from W), off without a buffer or when asked; Z asked with a W format is an error.
+pub fn resolve<F: Codec>(asked: DepthMode, has_buffer: bool) -> Result<Resolved, Error> {
+    let stores_w = F::INPUT == Input::W;
+    let mode = match (asked, has_buffer) {
+        (DepthMode::Off, _) | (_, false) => DepthMode::Off,
+        (DepthMode::Z, true) if stores_w => return Err(Error::ZWithWFormat),
+        (DepthMode::Z, true) => DepthMode::Z,
+        (DepthMode::W, true) if stores_w => DepthMode::W,
+        (DepthMode::W, true) => DepthMode::Z,
+    };
+    Ok(Resolved {
+        mode,
+        fell_back: asked == DepthMode::W && mode == DepthMode::Z,
+    })
+}
+
+impl<R: WSpan> Rasterizer<R> {
+    /// What a draw into a buffer of format `F` (or into none) does with the state's [`DepthMode`].
+    pub fn resolve<F: Codec>(&self, has_buffer: bool) -> Result<Resolved, Error> {
+        resolve::<F>(self.state.mode, has_buffer)
+    }
+
+    /// Draws one flat-coloured triangle into `target` and a depth buffer of any format (or none: depth off; the rows
+    /// and columns are then the target's). The depth test runs before any colour work for the pixel (seed 001): a
+    /// passing pixel's colour is sent with its run. On an error nothing is written.
+    pub fn draw_format<F: Codec, D>(
+        &mut self,
+        target: &mut D,
+        mut depth: Option<&mut Packed<'_, F>>,
+        v: &[Vertex<D::Color>; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        let res = self.resolve::<F>(depth.is_some())?;
+        let (y0, height, width) = match &depth {
+            Some(d) => (d.y0(), d.height(), d.width()),
+            None => {
+                let b = target.bounding_box();
+                let w = (b.top_left.x.max(0) as u32 + b.size.width).min(u16::MAX as u32);
+                (
+                    b.top_left.y,
+                    b.size.height.min(u16::MAX as u32) as u16,
+                    w as u16,
+                )
+            }
+        };
+        let mut w = match self.prepare(v, (y0, height))? {
+            Ok(w) => w,
+            Err(stats) => return Ok(stats),
+        };
+        let (_, fm, fe) = split(self.state.range.far()).ok_or(Error::NonFinite)?;
+        let far = (fm, fe);
+        let frac = w.frac;
+        let zc = ZConst::new(&self.state.range);
+        let mut lin = (F::INPUT == Input::LinearZ)
+            .then(|| Plane::solve(w.t_vertex.map(|t| linear_z60(&zc, t, frac)), &w.geom));
+        let bias = self.format_bias::<F>(&w, &zc, far);
+        let (cmp, write) = (self.state.compare, self.state.depth_write);
+        let (t_lo, t_hi) = (w.span.t_lo, w.span.t_hi);
+        let color = v[0].color;
+        let mut stats = Stats::default();
+        for j in w.geom.j0..=w.j1 {
+            if let Some((lo, hi)) = w.row(width) {
+                let n = (hi - lo) as usize;
+                let off = lo as i64 - w.geom.i_ref;
+                let t0 = w.t.at(off) as u64;
+                let mut runs = Runs {
+                    target,
+                    lo,
+                    j,
+                    color,
+                    start: 0,
+                    fails: 0,
+                };
+                match depth.as_deref_mut() {
+                    Some(buf) if res.mode != DepthMode::Off => {
+                        let row = buf.row_mut(j, lo, hi);
+                        let mut test = |k: usize, code: Option<u32>| -> Result<(), Error> {
+                            if let Some(c) = code {
+                                let c = biased::<F>(c, bias);
+                                let px = &mut row[k * F::BYTES..(k + 1) * F::BYTES];
+                                let stored = F::unpack(px);
+                                let pass = if F::REVERSED {
+                                    cmp.test(stored, c)
+                                } else {
+                                    cmp.test(c, stored)
+                                };
+                                if pass {
+                                    if write {
+                                        F::pack(c, px);
+                                    }
+                                    return Ok(());
+                                }
+                            }
+                            runs.fail(k)
+                        };
+                        let in_range = |t: u64| t >= t_lo && t <= t_hi;
+                        match F::INPUT {
+                            Input::W => {
+                                self.recip.walk(t0, w.t.sx, n, frac, t_lo, t_hi, |k, u| {
+                                    test(k, u.map(|u| F::code(u, far)))
+                                })?
+                            }
+                            Input::Z => {
+                                let mut t = t0;
+                                for k in 0..n {
+                                    test(k, in_range(t).then(|| F::code(zc.z60(t, frac), far)))?;
+                                    t = t.wrapping_add(w.t.sx as u64);
+                                }
+                            }
+                            Input::LinearZ => {
+                                let p = lin.unwrap_or(w.t);
+                                let mut z = p.at(off);
+                                let mut t = t0;
+                                for k in 0..n {
+                                    let q = z.clamp(0, 1 << 60) as u64;
+                                    test(k, in_range(t).then(|| F::code(q, far)))?;
+                                    t = t.wrapping_add(w.t.sx as u64);
+                                    z = z.wrapping_add(p.sx);
+                                }
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+                runs.finish(n)?;
+                stats.fragments += n as u32;
+                stats.written += n as u32 - runs.fails;
+            }
+            w.next_row();
+            if let Some(p) = &mut lin {
+                p.next_row();
+            }
+        }
+        Ok(stats)
+    }
+
+    /// The triangle's depth bias in `F`'s codes (feature `bias`): seed 001's offset with `m` from the plane of the
+    /// vertices' codes (see [`crate::RenderState::depth_bias`]).
+    #[cfg(feature = "bias")]
+    fn format_bias<F: Codec>(&self, w: &crate::raster::Walk, zc: &ZConst, far: (u32, i32)) -> i32 {
+        let st = &self.state;
+        if st.slope_scale_depth_bias == 0.0 && st.depth_bias == 0.0 {
+            return 0;
+        }
+        let (lo, hi) = (w.span.t_lo as i64, w.span.t_hi as i64);
+        let codes = w.t_vertex.map(|t| {
+            let tc = t.clamp(lo, hi.max(lo));
+            let q = match F::INPUT {
+                Input::W => exact_u(tc as u64, w.frac),
+                Input::Z => zc.z60(tc as u64, w.frac),
+                Input::LinearZ => linear_z60(zc, tc, w.frac).clamp(0, 1 << 60) as u64,
+            };
+            F::code(q, far) as f32
+        });
+        slope_bias(st, &w.geom.p, codes, F::MAX_CODE as f32)
+    }
+    #[cfg(not(feature = "bias"))]
+    #[inline(always)]
+    fn format_bias<F: Codec>(&self, _: &crate::raster::Walk, _: &ZConst, _: (u32, i32)) -> i32 {
+        0
+    }
+}
+
+/// `code` moved `bias` codes away from the eye in depth order (towards smaller codes for reversed formats),
+/// saturated to `[0, MAX_CODE]`.
+#[inline(always)]
+fn biased<F: Codec>(code: u32, bias: i32) -> u32 {
+    if bias == 0 {
+        return code;
+    }
+    let b = if F::REVERSED {
+        -(bias as i64)
+    } else {
+        bias as i64
+    };
+    (code as i64 + b).clamp(0, F::MAX_CODE as i64) as u32
+}
