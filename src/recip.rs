@@ -649,6 +649,58 @@ mod tests {
         (worst, pixels, smooth_spans)
     }
 
+    /// `WSpan::walk` along random spans with `T = t 2^32`, `t` in `[1, 2^30]`: every `u` against the exact
+    /// `2^94 / T`, within `Quake::span_bound` for the Quake strategies (a derived bound per span, which grows with
+    /// `(N dt / t)^2`) and within `MAX_REL_ERROR` for a per-pixel reciprocal. Returns the worst error over its bound.
+    fn walk_spans<S: WSpan>(bound: impl Fn(u64, i64, usize) -> f64) -> (f64, f64) {
+        let (mut worst, mut worst_abs) = (0.0f64, 0.0f64);
+        let mut state: u64 = 0x2545_F491_4F6C_DD1D;
+        let mut rnd = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let frac = 32;
+        let (lo, hi) = (1u64 << frac, 1u64 << 62);
+        for _ in 0..4000 {
+            let t0 = lo + rnd() % (1u64 << (33 + rnd() % 29));
+            let n = 1 + (rnd() % 300) as usize;
+            let lim = (t0 >> 2) as i64;
+            let dt = ((rnd() % (2 * lim as u64 + 1)) as i64 - lim) >> (rnd() % 24);
+            let end = t0 as i128 + dt as i128 * (n as i128 - 1);
+            if !(lo as i128..=hi as i128).contains(&end) {
+                continue;
+            }
+            let b = bound(t0, dt, n);
+            let mut s = S::default();
+            s.walk(t0, dt, n, frac, lo, hi, |k, u| -> Result<(), ()> {
+                let t = (t0 as i128 + dt as i128 * k as i128) as f64;
+                let exact = 2f64.powi(94) / t;
+                let e = (u.unwrap() as f64 / exact - 1.0).abs();
+                worst = worst.max(e / b);
+                worst_abs = worst_abs.max(e);
+                Ok(())
+            })
+            .unwrap();
+        }
+        (worst, worst_abs)
+    }
+
+    #[test]
+    fn quake_and_per_pixel_walks_hold_their_bounds() {
+        let (q8, a8) = walk_spans::<Quake<8>>(Quake::<8>::span_bound);
+        let (q16, a16) = walk_spans::<Quake<16>>(Quake::<16>::span_bound);
+        let (pp, app) =
+            walk_spans::<PerPixel<DefaultRecip>>(|_, _, _| PerPixel::<DefaultRecip>::MAX_REL_ERROR);
+        std::println!(
+            "walk: quake-8 worst {a8:e} ({q8:.3} of its bound), quake-16 {a16:e} ({q16:.3}), per-pixel {app:e} ({pp:.3})"
+        );
+        assert!(q8 <= 1.0 && q16 <= 1.0 && pp <= 1.0);
+        // Quake's error is real on fast spans (the bound is not vacuous): above 2^-20 somewhere.
+        assert!(a16 > 2f64.powi(-20));
+    }
+
     #[test]
     fn span_walker_and_reciprocals_hold_their_bounds_along_spans() {
         let (worst, pixels, smooth) = spans::<PrevPixel>();

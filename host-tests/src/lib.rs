@@ -5,6 +5,8 @@
 //! coverage by evaluating the three edge functions at every pixel centre in i64, and W at each centre by barycentric
 //! perspective interpolation of `1/W` in f64.
 
+pub mod plot;
+
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::*;
 use embedded_graphics::primitives::Rectangle;
@@ -188,6 +190,8 @@ pub struct RefFrame {
     /// The exact depth of the second-nearest surface drawn at each pixel (`f64::INFINITY` if none): where it is within
     /// 2 LSB of the nearest, either may win in a W16 buffer.
     pub runner_up: Vec<f64>,
+    /// Whether any triangle covers the pixel in range.
+    pub covered: Vec<bool>,
 }
 
 /// Renders `tris` with the reference.
@@ -204,6 +208,7 @@ pub fn reference_frame(
         depth: vec![1.0; n],
         code: vec![65535; n],
         runner_up: vec![f64::INFINITY; n],
+        covered: vec![false; n],
     };
     let mut best = vec![f64::INFINITY; n];
     for tri in tris {
@@ -213,6 +218,7 @@ pub fn reference_frame(
                 continue;
             }
             let k = (p.y as u32 * w + p.x as u32) as usize;
+            f.covered[k] = true;
             let d = 1.0 / p.t;
             if d < best[k] {
                 f.runner_up[k] = best[k];
@@ -344,6 +350,48 @@ pub fn half_step<F: DepthFormat>(code: u32, n: f64, f: f64) -> f64 {
         0.0
     };
     up.max(down) / 2.0
+}
+
+/// Whether `cmd --version` runs.
+pub fn have(cmd: &str) -> bool {
+    std::process::Command::new(cmd)
+        .arg("--version")
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false)
+}
+
+/// Builds and runs firmware board `board` (a directory of boards/) under QEMU with cargo `features`, from the
+/// board's directory so its target and runner (.cargo/config.toml) apply; its stdout, or why it failed.
+pub fn run_board(board: &str, features: &[&str]) -> Result<String, String> {
+    let boards = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../boards");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let mut cmd = std::process::Command::new(&cargo);
+    cmd.args(["run", "--release", "--quiet"]);
+    if !features.is_empty() {
+        cmd.args(["--features", &features.join(",")]);
+    }
+    let out = cmd
+        .current_dir(boards.join(board))
+        .env_remove("CARGO_TARGET_DIR")
+        .output()
+        .map_err(|e| format!("cargo: {e}"))?;
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    if out.status.success() {
+        Ok(stdout)
+    } else {
+        Err(format!(
+            "{board} failed: {}\n{stdout}\n{}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        ))
+    }
+}
+
+/// The value of `key=` in a `bench ...` line.
+pub fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {
+    line.split(' ')
+        .find_map(|kv| kv.strip_prefix(key).and_then(|v| v.strip_prefix('=')))
 }
 
 /// A small xorshift64 generator for reproducible tests.

@@ -9,11 +9,9 @@
 //! required (a missing emulator fails the test instead of skipping it).
 
 use std::collections::HashMap;
-use std::path::Path;
-use std::process::Command;
 
 use embedded_graphics::pixelcolor::IntoStorage;
-use host_tests::render;
+use host_tests::{have, render, run_board};
 use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
 use wraster::scenes::{Scene, HEIGHT, WIDTH};
 use wraster::RenderState;
@@ -58,22 +56,13 @@ fn host_runs<R: SpanRecip>(out: &mut HashMap<(String, String), (u64, u32, u32)>)
     }
 }
 
-fn field<'a>(line: &'a str, key: &str) -> &'a str {
-    line.split(' ')
-        .find_map(|kv| kv.strip_prefix(key).and_then(|v| v.strip_prefix('=')))
-        .unwrap_or_else(|| panic!("no {key}= in {line}"))
-}
-
-fn have(cmd: &str) -> bool {
-    Command::new(cmd)
-        .arg("--version")
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false)
-}
-
 #[test]
 fn boards_render_the_hosts_frames_bit_for_bit() {
+    let field = |line: &str, key: &str| -> String {
+        host_tests::field(line, key)
+            .unwrap_or_else(|| panic!("no {key}= in {line}"))
+            .to_string()
+    };
     let required = std::env::var("CI").is_ok_and(|v| v == "true");
     if !(have("qemu-system-arm") && have("qemu-system-riscv32")) {
         assert!(
@@ -87,23 +76,8 @@ fn boards_render_the_hosts_frames_bit_for_bit() {
     host_runs::<PerPixel<DefaultRecip>>(&mut host);
     host_runs::<PrevPixel>(&mut host);
 
-    let boards = Path::new(env!("CARGO_MANIFEST_DIR")).join("../boards");
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     for (board, bands) in [("qemu-m4", 1), ("qemu-m0", 30), ("qemu-rv32", 1)] {
-        // `cargo run` from the board's directory picks up its target and QEMU runner (.cargo/config.toml).
-        let out = Command::new(&cargo)
-            .args(["run", "--release", "--quiet"])
-            .current_dir(boards.join(board))
-            .env_remove("CARGO_TARGET_DIR")
-            .output()
-            .expect("cargo runs");
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
-            "{board} failed: {}\n{stdout}\n{}",
-            out.status,
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let stdout = run_board(board, &[]).unwrap_or_else(|e| panic!("{e}"));
         let mut seen = 0;
         for line in stdout.lines().filter(|l| l.starts_with("bench ")) {
             let key = (
