@@ -5,76 +5,93 @@
 use std::time::Instant;
 
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
-use host_tests::{reference_frame, reference_tri, render, Frame};
+use host_tests::{reference_frame, render, render_format, Frame};
 use wraster::format::{DepthFormat, W16, W16F, Z16};
 use wraster::recip::{DefaultRecip, PerPixel};
 use wraster::scenes::{Scene, HEIGHT, WIDTH};
+use wraster::Codec;
 use wraster::RenderState;
 
-/// The winning triangle per pixel when the scene's depths are stored in format `F` and compared with Less, on the
-/// f64 reference's coverage and exact per-pixel depth: the storage format is the only thing that differs.
-/// (The rasterizer itself writes W16 only so far; this isolates what each format can resolve.)
-fn winners<F: DepthFormat>(
-    tris: &[[wraster::Vertex<Rgb565>; 3]],
-    near: f32,
-    far: f32,
+/// A distinct colour per triangle index, to tell which triangle a pixel shows.
+fn id_color(k: usize) -> Rgb565 {
+    let k = k as u16 + 1;
+    Rgb565::new((k >> 11) as u8, ((k >> 5) & 63) as u8, (k & 31) as u8)
+}
+
+fn id_of(c: Rgb565) -> Option<usize> {
+    let v = ((c.r() as u16) << 11) | ((c.g() as u16) << 5) | c.b() as u16;
+    (v > 0).then(|| v as usize - 1)
+}
+
+/// The visible triangle per pixel when the rasterizer draws the scene into a buffer of format `F` (Less, the default
+/// reciprocal; triangles coloured by index).
+fn winners<F: Codec>(
+    ids: &[[wraster::Vertex<Rgb565>; 3]],
+    state: RenderState,
 ) -> Vec<Option<usize>> {
-    let n = WIDTH as usize * HEIGHT as usize;
-    let (mut code, mut win) = (
-        vec![F::encode(far as f64, near as f64, far as f64); n],
-        vec![None; n],
-    );
-    let exact = F::NAME == "exact";
-    let mut best = vec![f64::INFINITY; n];
-    for (k, tri) in tris.iter().enumerate() {
-        let v = tri.map(|q| (q.x, q.y, q.rhw));
-        for p in reference_tri(&v, near, far, WIDTH as i32, 0..HEIGHT as i32).unwrap_or_default() {
-            if !p.in_range {
-                continue;
-            }
-            let i = p.y as usize * WIDTH as usize + p.x as usize;
-            let d = far as f64 / p.t;
-            let c = F::encode(d, near as f64, far as f64);
-            let pass = if exact { d < best[i] } else { c < code[i] };
-            if pass {
-                code[i] = c;
-                best[i] = d;
-                win[i] = Some(k);
-            }
+    let (frame, _, _) =
+        render_format::<F, PerPixel<DefaultRecip>>(ids, state, WIDTH, HEIGHT).expect("scene draws");
+    frame.px.iter().map(|&c| id_of(c)).collect()
+}
+
+/// The far scene: twelve billboards between W = 1500 and 9000, each with a second one 0.3% farther behind it,
+/// offset so both show, the farther drawn first (so a format that cannot tell them apart shows the wrong one);
+/// the terrain's range (near 10, far 10000). Z16 cannot separate them (its step at 5000 is about
+/// 38 units), W16 can (0.15 units everywhere).
+fn far_scene() -> Vec<[wraster::Vertex<Rgb565>; 3]> {
+    let colors = [Rgb565::RED, Rgb565::BLUE, Rgb565::YELLOW, Rgb565::CYAN];
+    let mut tris = Vec::new();
+    for k in 0..12 {
+        let (col, row) = ((k % 4) as f32, (k / 4) as f32);
+        let w = 1500.0 + 650.0 * k as f32;
+        let (x, y) = (10.0 + 78.0 * col, 12.0 + 76.0 * row);
+        for (layer, (dx, dy, scale)) in [(14.0f32, 10.0f32, 1.003f32), (0.0, 0.0, 1.0)]
+            .into_iter()
+            .enumerate()
+        {
+            let c = colors[(k + layer) % 4];
+            let v = |px: f32, py: f32, dw: f32| {
+                wraster::Vertex::new(x + dx + px, y + dy + py, (w + dw) * scale, c)
+            };
+            tris.push([v(0.0, 0.0, 0.0), v(52.0, 0.0, 40.0), v(52.0, 50.0, 60.0)]);
+            tris.push([v(0.0, 0.0, 0.0), v(52.0, 50.0, 60.0), v(0.0, 50.0, 20.0)]);
         }
     }
-    win
+    tris
 }
 
-/// Exact f64 visibility (the nearest surface at each pixel), as a "format" for [`winners`].
-struct Exact;
-impl DepthFormat for Exact {
-    const NAME: &'static str = "exact";
-    const BYTES: usize = 4;
-    const MAX_CODE: u32 = u32::MAX;
-    fn encode(_d: f64, _n: f64, _f: f64) -> u32 {
-        0
-    }
-    fn decode(_c: u32, _n: f64, f: f64) -> f64 {
-        f
-    }
-    fn fraction(_c: u32, _n: f64, _f: f64) -> f64 {
-        0.0
-    }
-}
-
-/// The side-by-side: Z16, W16 and W16F panels, pixels whose visible surface differs from the f64 reference in
-/// magenta; prints one `formats` line per format and returns the PNG path.
-fn side_by_side(tris: &[[wraster::Vertex<Rgb565>; 3]], near: f32, far: f32) -> std::path::PathBuf {
-    let truth = winners::<Exact>(tris, near, far);
+/// One row of the side-by-side: Z16, W16 and W16F panels drawn by the rasterizer, pixels whose visible surface
+/// differs from the f64 reference in magenta; prints one `formats` line per format.
+fn side_by_side(
+    name: &str,
+    tris: &[[wraster::Vertex<Rgb565>; 3]],
+    state: RenderState,
+    out: &mut Frame,
+    row: usize,
+) {
+    let (near, far) = (state.range.near(), state.range.far());
+    let ids: Vec<_> = tris
+        .iter()
+        .enumerate()
+        .map(|(k, t)| {
+            t.map(|v| wraster::Vertex {
+                color: id_color(k),
+                ..v
+            })
+        })
+        .collect();
+    let truth: Vec<Option<usize>> = reference_frame(&ids, near, far, WIDTH as u32, HEIGHT as u32)
+        .px
+        .iter()
+        .map(|&c| id_of(c))
+        .collect();
     let (w, h) = (WIDTH as usize, HEIGHT as usize);
-    let mut out = Frame::new(3 * WIDTH as u32 + 8, HEIGHT as u32);
     let panels = [
-        (Z16::NAME, winners::<Z16>(tris, near, far)),
-        (W16::NAME, winners::<W16>(tris, near, far)),
-        (W16F::NAME, winners::<W16F>(tris, near, far)),
+        (Z16::NAME, winners::<Z16>(&ids, state)),
+        (W16::NAME, winners::<W16>(&ids, state)),
+        (W16F::NAME, winners::<W16F>(&ids, state)),
     ];
-    for (k, (name, win)) in panels.iter().enumerate() {
+    for (k, (format, win)) in panels.iter().enumerate() {
         let mut differ = 0;
         for i in 0..w * h {
             let c = if win[i] != truth[i] {
@@ -83,15 +100,12 @@ fn side_by_side(tris: &[[wraster::Vertex<Rgb565>; 3]], near: f32, far: f32) -> s
             } else {
                 win[i].map_or(Rgb565::BLACK, |t| tris[t][0].color)
             };
-            out.px[(i / w) * out.w as usize + k * (w + 4) + i % w] = c;
+            out.px[(row * (h + 4) + i / w) * out.w as usize + k * (w + 4) + i % w] = c;
         }
         println!(
-            "formats scene=terrain format={name} near={near} far={far} visibility_differs={differ}"
+            "formats scene={name} format={format} near={near} far={far} visibility_differs={differ} source=rasterizer"
         );
     }
-    let png = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/demo/formats.png");
-    out.save_png(&png);
-    png.canonicalize().unwrap_or(png)
 }
 
 fn main() {
@@ -129,7 +143,14 @@ fn main() {
     let png = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/demo/terrain.png");
     frame.save_png(&png);
     let png = png.canonicalize().unwrap_or(png);
-    let formats_png = side_by_side(&tris, near, far);
+    // The side-by-side: the terrain (near the eye) and the far scene, with Z16, W16 and W16F.
+    let mut out = Frame::new(3 * WIDTH as u32 + 8, 2 * HEIGHT as u32 + 4);
+    side_by_side("terrain", &tris, state, &mut out, 0);
+    side_by_side("far", &far_scene(), state, &mut out, 1);
+    let formats_png =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/demo/formats.png");
+    out.save_png(&formats_png);
+    let formats_png = formats_png.canonicalize().unwrap_or(formats_png);
     println!("formats png={}", formats_png.display());
     println!(
         "triangles={} fragments={} written={} culled={}",
