@@ -3,7 +3,6 @@
 
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::pixelcolor::RgbColor;
-use embedded_graphics::prelude::*;
 use host_tests::{
     exact_fraction, half_step, random_tri, reference_tri, render, render_format, Frame, Rng,
 };
