@@ -17,12 +17,15 @@ use core::marker::PhantomData;
 
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::PixelColor;
+use embedded_graphics_core::prelude::{Point, Size};
+use embedded_graphics_core::primitives::Rectangle;
 
+use crate::edge::Sub;
 use crate::fixed::{div_u128, split};
 use crate::format::{DepthFormat, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
 #[cfg(feature = "bias")]
 use crate::raster::slope_bias;
-use crate::raster::{Plane, Runs, Stats, Vertex};
+use crate::raster::{div_round, Plane, Runs, Stats, Vertex};
 #[cfg(feature = "bias")]
 use crate::recip::exact_u;
 use crate::recip::WSpan;
@@ -315,6 +318,14 @@ impl<'a, F: Codec> Packed<'a, F> {
         let k = (r as usize * self.width as usize + x as usize) * F::BYTES;
         Some(F::unpack(&self.data[k..k + F::BYTES]))
     }
+    fn pixel_mut(&mut self, x: i32, y: i32) -> Option<&mut [u8]> {
+        let r = y.checked_sub(self.y0)?;
+        if x < 0 || x >= self.width as i32 || r < 0 || r >= self.height as i32 {
+            return None;
+        }
+        let k = (r as usize * self.width as usize + x as usize) * F::BYTES;
+        Some(&mut self.data[k..k + F::BYTES])
+    }
     fn row_mut(&mut self, y: i32, lo: i32, hi: i32) -> &mut [u8] {
         let r = (y - self.y0) as usize * self.width as usize;
         &mut self.data[(r + lo as usize) * F::BYTES..(r + hi as usize) * F::BYTES]
@@ -389,9 +400,16 @@ impl<R: WSpan> Rasterizer<R> {
         let zc = ZConst::new(&self.state.range);
         let mut lin = (F::INPUT == Input::LinearZ)
             .then(|| Plane::solve(w.t_vertex.map(|t| linear_z60(&zc, t, frac)), &w.geom));
-        let bias = self.format_bias::<F>(&w, &zc, far);
-        let (cmp, write) = (self.state.compare, self.state.depth_write);
-        let (t_lo, t_hi) = (w.span.t_lo, w.span.t_hi);
+        let ctx = DepthCtx {
+            far,
+            zc,
+            frac,
+            t_lo: w.span.t_lo,
+            t_hi: w.span.t_hi,
+            bias: self.format_bias::<F>(&w.geom.p, &w.t_vertex, frac, (w.span.t_lo, w.span.t_hi)),
+            cmp: self.state.compare,
+            write: self.state.depth_write,
+        };
         let color = v[0].color;
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {
@@ -407,56 +425,33 @@ impl<R: WSpan> Rasterizer<R> {
                     start: 0,
                     fails: 0,
                 };
-                match depth.as_deref_mut() {
-                    Some(buf) if res.mode != DepthMode::Off => {
-                        let row = buf.row_mut(j, lo, hi);
-                        let mut test = |k: usize, code: Option<u32>| -> Result<(), Error> {
-                            if let Some(c) = code {
-                                let c = biased::<F>(c, bias);
-                                let px = &mut row[k * F::BYTES..(k + 1) * F::BYTES];
-                                let stored = F::unpack(px);
-                                let pass = if F::REVERSED {
-                                    cmp.test(stored, c)
-                                } else {
-                                    cmp.test(c, stored)
-                                };
-                                if pass {
-                                    if write {
-                                        F::pack(c, px);
-                                    }
-                                    return Ok(());
-                                }
-                            }
-                            runs.fail(k)
-                        };
-                        let in_range = |t: u64| t >= t_lo && t <= t_hi;
-                        match F::INPUT {
-                            Input::W => {
-                                self.recip.walk(t0, w.t.sx, n, frac, t_lo, t_hi, |k, u| {
-                                    test(k, u.map(|u| F::code(u, far)))
-                                })?
-                            }
-                            Input::Z => {
-                                let mut t = t0;
-                                for k in 0..n {
-                                    test(k, in_range(t).then(|| F::code(zc.z60(t, frac), far)))?;
-                                    t = t.wrapping_add(w.t.sx as u64);
-                                }
-                            }
-                            Input::LinearZ => {
-                                let p = lin.unwrap_or(w.t);
-                                let mut z = p.at(off);
-                                let mut t = t0;
-                                for k in 0..n {
-                                    let q = z.clamp(0, 1 << 60) as u64;
-                                    test(k, in_range(t).then(|| F::code(q, far)))?;
-                                    t = t.wrapping_add(w.t.sx as u64);
-                                    z = z.wrapping_add(p.sx);
-                                }
-                            }
+                if let (Some(buf), true) = (depth.as_deref_mut(), res.mode != DepthMode::Off) {
+                    let row = buf.row_mut(j, lo, hi);
+                    let z0 = lin.map_or(0, |p| p.at(off));
+                    let dz = lin.map_or(0, |p| p.sx);
+                    let line = Line1 {
+                        t0,
+                        dt: w.t.sx,
+                        z0,
+                        dz,
+                    };
+                    codes::<F, R, Error>(&mut self.recip, &ctx, &line, n, |k, code| {
+                        let px = &mut row[k * F::BYTES..(k + 1) * F::BYTES];
+                        match code {
+                            Some(c) if ctx.test::<F>(px, c) => Ok(()),
+                            _ => runs.fail(k),
                         }
+                    })?;
+                } else {
+                    // depth off: every covered pixel in the depth range passes (the range clips, as for points and
+                    // lines)
+                    let mut t = t0;
+                    for k in 0..n {
+                        if t < ctx.t_lo || t > ctx.t_hi {
+                            runs.fail(k)?;
+                        }
+                        t = t.wrapping_add(w.t.sx as u64);
                     }
-                    _ => {}
                 }
                 runs.finish(n)?;
                 stats.fragments += n as u32;
@@ -473,27 +468,384 @@ impl<R: WSpan> Rasterizer<R> {
     /// The triangle's depth bias in `F`'s codes (feature `bias`): seed 001's offset with `m` from the plane of the
     /// vertices' codes (see [`crate::RenderState::depth_bias`]).
     #[cfg(feature = "bias")]
-    fn format_bias<F: Codec>(&self, w: &crate::raster::Walk, zc: &ZConst, far: (u32, i32)) -> i32 {
+    fn format_bias<F: Codec>(
+        &self,
+        p: &[Sub; 3],
+        t: &[i64; 3],
+        frac: u32,
+        range: (u64, u64),
+    ) -> i32 {
         let st = &self.state;
         if st.slope_scale_depth_bias == 0.0 && st.depth_bias == 0.0 {
             return 0;
         }
-        let (lo, hi) = (w.span.t_lo as i64, w.span.t_hi as i64);
-        let codes = w.t_vertex.map(|t| {
-            let tc = t.clamp(lo, hi.max(lo));
+        let (_, fm, fe) = split(st.range.far()).unwrap_or((false, 1, 0));
+        let zc = ZConst::new(&st.range);
+        // T is at most 2^61 here; t_max may saturate to u64::MAX: clamp in u64.
+        let codes = t.map(|t| {
+            let tc = (t.max(0) as u64).clamp(range.0, range.1.max(range.0));
             let q = match F::INPUT {
-                Input::W => exact_u(tc as u64, w.frac),
-                Input::Z => zc.z60(tc as u64, w.frac),
-                Input::LinearZ => linear_z60(zc, tc, w.frac).clamp(0, 1 << 60) as u64,
+                Input::W => exact_u(tc, frac),
+                Input::Z => zc.z60(tc, frac),
+                Input::LinearZ => linear_z60(&zc, tc as i64, frac).clamp(0, 1 << 60) as u64,
             };
-            F::code(q, far) as f32
+            F::code(q, (fm, fe)) as f32
         });
-        slope_bias(st, &w.geom.p, codes, F::MAX_CODE as f32)
+        slope_bias(st, p, codes, F::MAX_CODE as f32)
     }
     #[cfg(not(feature = "bias"))]
     #[inline(always)]
-    fn format_bias<F: Codec>(&self, _: &crate::raster::Walk, _: &ZConst, _: (u32, i32)) -> i32 {
+    fn format_bias<F: Codec>(&self, _: &[Sub; 3], _: &[i64; 3], _: u32, _: (u64, u64)) -> i32 {
         0
+    }
+}
+
+/// Points, lines and wireframe triangles (seed 001's primitives), through the same `T` (RHW) path, the same
+/// W strategy and the same depth test as solid triangles. Depth bias applies to wireframe triangles, never to points
+/// or lines (seed 001).
+///
+/// Rules. A point covers the pixel that contains it, `(floor x, floor y)`, at its own depth. A line covers, for each
+/// column (x-major, `|dx| >= |dy|`) or row (y-major) whose pixel centre lies in `[start, end)` of the snapped
+/// endpoints' major coordinate (ordered increasing), the pixel containing the line's point at that centre: one pixel
+/// per major step, the upper endpoint excluded, so connected lines share no pixel. `T` along it is the line's exact
+/// interpolation at the pixel centre, its step rounded once (as for triangles: at `k` steps it errs by at most
+/// `(1 + k) / 2` units of `2^-F`). A wireframe triangle is culled like a solid one and draws its three edges with the
+/// triangle's depth bias, in its first vertex's colour.
+impl<R: WSpan> Rasterizer<R> {
+    /// Draws one point. On an error nothing is written.
+    pub fn draw_point_format<F: Codec, D>(
+        &mut self,
+        target: &mut D,
+        depth: Option<&mut Packed<'_, F>>,
+        v: &Vertex<D::Color>,
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        let s = self.setup(core::array::from_ref(v))?;
+        let zc = ZConst::new(&self.state.range);
+        let z = linear_z60(&zc, s.t[0], s.frac);
+        let line = Line1 {
+            t0: s.t[0] as u64,
+            dt: 0,
+            z0: z,
+            dz: 0,
+        };
+        let at = |_k: usize| (s.p[0].x >> 8, s.p[0].y >> 8);
+        self.pixels::<F, D>(target, depth, &line, 1, at, 0, s.frac, v.color)
+    }
+
+    /// Draws one line from `v[0]` to `v[1]` (flat, `v[0]`'s colour). On an error nothing is written.
+    pub fn draw_line_format<F: Codec, D>(
+        &mut self,
+        target: &mut D,
+        depth: Option<&mut Packed<'_, F>>,
+        v: &[Vertex<D::Color>; 2],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        let s = self.setup(v)?;
+        self.line_inner::<F, D>(
+            target,
+            depth,
+            (s.p[0], s.p[1]),
+            (s.t[0], s.t[1]),
+            s.frac,
+            0,
+            v[0].color,
+        )
+    }
+
+    /// Draws the three edges of a triangle, culled like a solid one, with its depth bias. On an error nothing is
+    /// written.
+    pub fn draw_wireframe_format<F: Codec, D>(
+        &mut self,
+        target: &mut D,
+        mut depth: Option<&mut Packed<'_, F>>,
+        v: &[Vertex<D::Color>; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        let s = self.setup(v)?;
+        let [p0, p1, p2] = s.p;
+        let area = (p1.x - p0.x) as i64 * (p2.y - p0.y) as i64
+            - (p2.x - p0.x) as i64 * (p1.y - p0.y) as i64;
+        let culled = match self.state.cull {
+            _ if area == 0 => true,
+            crate::Cull::Cw => area > 0,
+            crate::Cull::Ccw => area < 0,
+            crate::Cull::None => false,
+        };
+        if culled {
+            return Ok(Stats {
+                culled: 1,
+                ..Stats::default()
+            });
+        }
+        let range = (1u64 << s.frac, self.state.range.t_max(s.frac));
+        let bias = self.format_bias::<F>(&s.p, &s.t, s.frac, range);
+        let mut stats = Stats::default();
+        for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+            stats += self.line_inner::<F, D>(
+                target,
+                depth.as_deref_mut(),
+                (s.p[a], s.p[b]),
+                (s.t[a], s.t[b]),
+                s.frac,
+                bias,
+                v[0].color,
+            )?;
+        }
+        Ok(stats)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn line_inner<F: Codec, D>(
+        &mut self,
+        target: &mut D,
+        depth: Option<&mut Packed<'_, F>>,
+        (a, b): (Sub, Sub),
+        (ta, tb): (i64, i64),
+        frac: u32,
+        bias: i32,
+        color: D::Color,
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        let (dx, dy) = ((b.x - a.x) as i64, (b.y - a.y) as i64);
+        if dx == 0 && dy == 0 {
+            return Ok(Stats {
+                culled: 1,
+                ..Stats::default()
+            });
+        }
+        let x_major = dx.abs() >= dy.abs();
+        let major = |p: Sub| {
+            if x_major {
+                (p.x as i64, p.y as i64)
+            } else {
+                (p.y as i64, p.x as i64)
+            }
+        };
+        let ((mut ua, mut va), (mut ub, mut vb)) = (major(a), major(b));
+        let (mut ta, mut tb) = (ta, tb);
+        if ua > ub {
+            core::mem::swap(&mut ua, &mut ub);
+            core::mem::swap(&mut va, &mut vb);
+            core::mem::swap(&mut ta, &mut tb);
+        }
+        // major pixels i with 256 i + 128 in [ua, ub)
+        let i0 = (ua - 128 + 255).div_euclid(256);
+        let i1 = (ub - 128 + 255).div_euclid(256); // exclusive
+        if i1 <= i0 {
+            return Ok(Stats::default());
+        }
+        let n = (i1 - i0) as usize;
+        let du = (ub - ua) as i128;
+        let off = (256 * i0 + 128 - ua) as i128;
+        let step = |v0: i64, v1: i64| {
+            let d = v1 as i128 - v0 as i128;
+            (
+                (v0 as i128 + div_round(d * off, du)) as i64,
+                div_round(d * 256, du) as i64,
+            )
+        };
+        let (t0, dt) = step(ta, tb);
+        let zc = ZConst::new(&self.state.range);
+        let (z0, dz) = if F::INPUT == Input::LinearZ {
+            step(linear_z60(&zc, ta, frac), linear_z60(&zc, tb, frac))
+        } else {
+            (0, 0)
+        };
+        let line = Line1 {
+            t0: t0 as u64,
+            dt,
+            z0,
+            dz,
+        };
+        let at = |k: usize| {
+            let i = i0 + k as i64;
+            // the minor coordinate at the centre, floor-divided into a pixel (|num| < 2^63: |du|, |dv| < 2^21)
+            let vv = va + ((256 * i + 128 - ua) * (vb - va)).div_euclid(ub - ua);
+            let j = vv.div_euclid(256);
+            let (x, y) = if x_major { (i, j) } else { (j, i) };
+            (
+                x.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+                y.clamp(i32::MIN as i64, i32::MAX as i64) as i32,
+            )
+        };
+        self.pixels::<F, D>(target, depth, &line, n, at, bias, frac, color)
+    }
+
+    /// The shared pixel loop of points and lines: pixel `k` of `n` is at `at(k)`, its depth from `line`.
+    #[allow(clippy::too_many_arguments)]
+    fn pixels<F: Codec, D>(
+        &mut self,
+        target: &mut D,
+        depth: Option<&mut Packed<'_, F>>,
+        line: &Line1,
+        n: usize,
+        at: impl Fn(usize) -> (i32, i32),
+        bias: i32,
+        frac: u32,
+        color: D::Color,
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        let res = self.resolve::<F>(depth.is_some())?;
+        let (y0, height, width) = match &depth {
+            Some(d) => (d.y0(), d.height(), d.width()),
+            None => {
+                let b = target.bounding_box();
+                let w = (b.top_left.x.max(0) as u32 + b.size.width).min(u16::MAX as u32);
+                (
+                    b.top_left.y,
+                    b.size.height.min(u16::MAX as u32) as u16,
+                    w as u16,
+                )
+            }
+        };
+        let (_, fm, fe) = split(self.state.range.far()).ok_or(Error::NonFinite)?;
+        let ctx = DepthCtx {
+            far: (fm, fe),
+            zc: ZConst::new(&self.state.range),
+            frac,
+            t_lo: 1 << frac,
+            t_hi: self.state.range.t_max(frac),
+            bias,
+            cmp: self.state.compare,
+            write: self.state.depth_write,
+        };
+        let inside =
+            |x: i32, y: i32| x >= 0 && x < width as i32 && y >= y0 && y < y0 + height as i32;
+        let mut stats = Stats::default();
+        let mut put = |x: i32, y: i32| -> Result<(), Error> {
+            stats.written += 1;
+            let r = Rectangle::new(Point::new(x, y), Size::new(1, 1));
+            target.fill_solid(&r, color).map_err(|_| Error::Target)
+        };
+        let mut frags = 0u32;
+        match depth {
+            Some(buf) if res.mode != DepthMode::Off => {
+                codes::<F, R, Error>(&mut self.recip, &ctx, line, n, |k, code| {
+                    let (x, y) = at(k);
+                    if !inside(x, y) {
+                        return Ok(());
+                    }
+                    frags += 1;
+                    let pass = match (code, buf.pixel_mut(x, y)) {
+                        (Some(c), Some(px)) => ctx.test::<F>(px, c),
+                        _ => false,
+                    };
+                    if pass {
+                        put(x, y)?;
+                    }
+                    Ok(())
+                })?;
+            }
+            _ => {
+                // depth off: every pixel in the depth range passes
+                let in_range = |t: u64| t >= ctx.t_lo && t <= ctx.t_hi;
+                let mut t = line.t0;
+                for k in 0..n {
+                    let (x, y) = at(k);
+                    if inside(x, y) {
+                        frags += 1;
+                        if in_range(t) {
+                            put(x, y)?;
+                        }
+                    }
+                    t = t.wrapping_add(line.dt as u64);
+                }
+            }
+        }
+        stats.fragments = frags;
+        Ok(stats)
+    }
+}
+
+/// Per-draw constants of the depth path.
+struct DepthCtx {
+    far: (u32, i32),
+    zc: ZConst,
+    frac: u32,
+    t_lo: u64,
+    t_hi: u64,
+    bias: i32,
+    cmp: crate::Compare,
+    write: bool,
+}
+
+impl DepthCtx {
+    /// The depth test of one pixel's stored bytes against `code` (biased), writing on a pass when enabled.
+    #[inline(always)]
+    fn test<F: Codec>(&self, px: &mut [u8], code: u32) -> bool {
+        let c = biased::<F>(code, self.bias);
+        let stored = F::unpack(px);
+        let pass = if F::REVERSED {
+            self.cmp.test(stored, c)
+        } else {
+            self.cmp.test(c, stored)
+        };
+        if pass && self.write {
+            F::pack(c, px);
+        }
+        pass
+    }
+}
+
+/// `n` consecutive pixels along which `T = t0 + k dt` and the linear-Z value `z0 + k dz` (used by `LinearZ` only).
+struct Line1 {
+    t0: u64,
+    dt: i64,
+    z0: i64,
+    dz: i64,
+}
+
+/// The codes of the pixels of `line`: `f(k, Some(code))` for those in the depth range, `f(k, None)` for the others.
+#[inline(always)]
+fn codes<F: Codec, R: WSpan, E>(
+    recip: &mut R,
+    ctx: &DepthCtx,
+    line: &Line1,
+    n: usize,
+    mut f: impl FnMut(usize, Option<u32>) -> Result<(), E>,
+) -> Result<(), E> {
+    let in_range = |t: u64| t >= ctx.t_lo && t <= ctx.t_hi;
+    match F::INPUT {
+        Input::W => recip.walk(line.t0, line.dt, n, ctx.frac, ctx.t_lo, ctx.t_hi, |k, u| {
+            f(k, u.map(|u| F::code(u, ctx.far)))
+        }),
+        Input::Z => {
+            let mut t = line.t0;
+            for k in 0..n {
+                f(
+                    k,
+                    in_range(t).then(|| F::code(ctx.zc.z60(t, ctx.frac), ctx.far)),
+                )?;
+                t = t.wrapping_add(line.dt as u64);
+            }
+            Ok(())
+        }
+        Input::LinearZ => {
+            let (mut t, mut z) = (line.t0, line.z0);
+            for k in 0..n {
+                let q = z.clamp(0, 1 << 60) as u64;
+                f(k, in_range(t).then(|| F::code(q, ctx.far)))?;
+                t = t.wrapping_add(line.dt as u64);
+                z = z.wrapping_add(line.dz);
+            }
+            Ok(())
+        }
     }
 }
 

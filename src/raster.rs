@@ -33,15 +33,16 @@ pub const SUBPIXEL_BITS: u32 = 8;
 pub const GUARD_BAND: i32 = 4096;
 const GUARD_LOG2: i32 = 12;
 
-/// A transformed-and-lit vertex, like Direct3D's TLVERTEX: `x`, `y` in pixels (pixel centres at `i + 0.5`), `z`
-/// (kept for Z modes), `rhw = 1/W`, and a colour.
+/// A transformed-and-lit vertex, like Direct3D's TLVERTEX: `x`, `y` in pixels (pixel centres at `i + 0.5`), `z`,
+/// `rhw = 1/W`, and a colour. Every depth mode takes its depth from `rhw` and the depth range (Z modes compute D3D's
+/// `Z = f/(f-n) (1 - n rhw)`, which is what a D3D projection puts in `z`), so `z` is only checked.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Vertex<C> {
     /// Pixels, right.
     pub x: f32,
     /// Pixels, down.
     pub y: f32,
-    /// Post-projection z (unused by the W-buffer, checked for finiteness).
+    /// Post-projection z (checked for finiteness; depth comes from `rhw`).
     pub z: f32,
     /// `1 / W`, `W` the eye-space depth; must be > 0.
     pub rhw: f32,
@@ -82,9 +83,9 @@ impl core::ops::AddAssign for Stats {
 }
 
 /// A triangle after snapping and checks.
-pub(crate) struct Setup {
-    pub(crate) p: [Sub; 3],
-    pub(crate) t: [i64; 3],
+pub(crate) struct Setup<const N: usize = 3> {
+    pub(crate) p: [Sub; N],
+    pub(crate) t: [i64; N],
     pub(crate) frac: u32,
 }
 
@@ -136,7 +137,7 @@ pub fn row_range<C>(v: &[Vertex<C>; 3]) -> Result<(i32, i32), Error> {
 }
 
 /// Rounded `n / d` for `d > 0` (ties away from zero).
-fn div_round(n: i128, d: i128) -> i128 {
+pub(crate) fn div_round(n: i128, d: i128) -> i128 {
     let (neg, a) = (n < 0, n.unsigned_abs() + (d as u128) / 2);
     let q = div_u128(a, d as u64);
     if neg {
@@ -163,11 +164,12 @@ impl<R: WSpan> Rasterizer<R> {
         }
     }
 
-    pub(crate) fn setup<C>(&self, v: &[Vertex<C>; 3]) -> Result<Setup, Error> {
+    /// Snaps and checks `N` vertices and gives their `T` with a common fraction count.
+    pub(crate) fn setup<C, const N: usize>(&self, v: &[Vertex<C>; N]) -> Result<Setup<N>, Error> {
         let (_, fm, fe) = split(self.state.range.far()).ok_or(Error::NonFinite)?;
-        let mut p = [Sub { x: 0, y: 0 }; 3];
-        let mut tm = [(0u64, 0i32); 3];
-        for k in 0..3 {
+        let mut p = [Sub { x: 0, y: 0 }; N];
+        let mut tm = [(0u64, 0i32); N];
+        for k in 0..N {
             if !v[k].z.is_finite() {
                 return Err(Error::NonFinite);
             }

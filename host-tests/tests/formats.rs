@@ -371,3 +371,78 @@ fn packed_buffers_check_their_size() {
     assert_eq!(buf.get(1, 1), Some(0));
     assert_eq!(buf.get(2, 1), None);
 }
+
+/// Depth bias in the packed path, in each format's codes (seed 001, "in the units of the buffer in use"), for two
+/// triangles in one plane (B inside A, drawn after it with `Less`; the geometry of bias.rs, depths 51 to 238, range
+/// 1..1000). Their stored codes disagree by at most `k` codes, so without bias B fights and with a bias of `-(k + 1)`
+/// it shows everywhere:
+/// - 16-bit formats: each code is within 1 of the exact value's (the bound above is far below half a code) and the
+///   exact values differ by the f32 rounding of RHW only (far below a code): `k = 3`;
+/// - reversed float Z: each value errs by `rz 2^-31 + 2^-30` (above), one code is `rz 2^-23` or more, and `rz >= 2^-10`
+///   for `d <= 500` here, so each is within `2^-6 / rz <= 16` codes plus a half of rounding; the f32 rounding of RHW
+///   moves `rz` by `t K 2^-24`, at most one code for `t >= 2`: `k = 2 * 16 + 2 = 34`. A negative bias is nearer in
+///   every format (for reversed Z it raises the code).
+///
+/// (LZ16 is not here: the linear-Z trick's interior error makes the smaller triangle B nearer than A everywhere, so the
+/// pair does not fight; it disagrees by far more than any bias should cover.)
+#[test]
+fn bias_removes_coplanar_fighting_in_every_16_bit_format_and_reversed_z() {
+    fn shown<F: Codec>(bias: f32) -> (usize, usize) {
+        let rhw = |x: f32, y: f32| (0.05 - 0.0007 * x as f64 - 0.0006 * y as f64) as f32;
+        let tri = |p: [(f32, f32); 3], c| {
+            p.map(|(x, y)| Vertex {
+                x,
+                y,
+                z: 0.5,
+                rhw: rhw(x, y),
+                color: c,
+            })
+        };
+        let a = tri([(2.0, 2.0), (62.0, 4.0), (4.0, 46.0)], Rgb565::RED);
+        let b = tri([(8.0, 7.0), (50.0, 12.0), (12.0, 38.0)], Rgb565::BLUE);
+        let base = RenderState::new(1.0, 1000.0).unwrap();
+        let mut frame = Frame::new(W as u32, H as u32);
+        let mut bytes = vec![0u8; W as usize * H as usize * F::BYTES];
+        let mut buf = Packed::<F>::new(&mut bytes, W, H).unwrap();
+        buf.clear(&base.range);
+        Rasterizer::<PerPixel<DefaultRecip>>::new(base)
+            .draw_format(&mut frame, Some(&mut buf), &a)
+            .unwrap();
+        let state = RenderState {
+            depth_bias: bias,
+            ..base
+        };
+        let s = Rasterizer::<PerPixel<DefaultRecip>>::new(state)
+            .draw_format(&mut frame, Some(&mut buf), &b)
+            .unwrap();
+        (
+            s.fragments as usize,
+            frame.px.iter().filter(|&&c| c == Rgb565::BLUE).count(),
+        )
+    }
+    fn check<F: Codec>(k: f32) {
+        let (n, s) = shown::<F>(0.0);
+        assert!(
+            n > 300 && s < n,
+            "{}: without bias the pair fights ({s} of {n})",
+            F::NAME
+        );
+        let (n, s) = shown::<F>(-(k + 1.0));
+        assert_eq!(
+            s,
+            n,
+            "{}: bias {} must show B everywhere",
+            F::NAME,
+            -(k + 1.0)
+        );
+        println!(
+            "{}: no bias fights, bias {} shows all {n}",
+            F::NAME,
+            -(k + 1.0)
+        );
+    }
+    check::<W16>(3.0);
+    check::<W16F>(3.0);
+    check::<Z16>(3.0);
+    check::<RZ32F>(34.0);
+}
