@@ -74,12 +74,7 @@ fn code(z: f64) -> f64 {
 fn check(t: [[f32; 3]; 3]) -> (usize, usize) {
     let m = projection();
     assert!(is_w_friendly(&m));
-    let vp = Viewport {
-        x: 0.0,
-        y: 0.0,
-        width: W as f32,
-        height: H as f32,
-    };
+    let vp = Viewport::new(0.0, 0.0, W as f32, H as f32);
     let mut frame = Frame::new(W as u32, H as u32);
     let mut depth = vec![0u16; W as usize * H as usize];
     let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
@@ -169,12 +164,7 @@ fn a_ground_plane_from_behind_the_eye_to_beyond_the_far_plane() {
 #[test]
 fn bad_world_input_is_an_error_and_writes_nothing() {
     let m = projection();
-    let vp = Viewport {
-        x: 0.0,
-        y: 0.0,
-        width: W as f32,
-        height: H as f32,
-    };
+    let vp = Viewport::new(0.0, 0.0, W as f32, H as f32);
     let mut frame = Frame::new(W as u32, H as u32);
     let mut depth = vec![0u16; W as usize * H as usize];
     let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
@@ -188,4 +178,106 @@ fn bad_world_input_is_an_error_and_writes_nothing() {
         );
     }
     assert!(frame.writes.iter().all(|&n| n == 0));
+}
+
+/// World space into any format: the packed path draws the same pixels and W16 codes as the lean one, for triangles
+/// crossing the near plane and lying partly behind the eye, and the Z formats get the same coverage.
+#[test]
+fn world_triangles_into_any_format() {
+    use wraster::format::{W16, Z16};
+    use wraster::recip::{DefaultRecip, PerPixel};
+    use wraster::Packed;
+    let m = projection();
+    let vp = Viewport::new(0.0, 0.0, W as f32, H as f32);
+    let tris = [
+        [[-3.0, -1.0, 0.3], [3.0, -1.0, 0.3], [0.0, 2.0, 80.0]],
+        [
+            [-30.0, -2.0, -20.0],
+            [30.0, -2.0, -20.0],
+            [0.0, -2.0, 300.0],
+        ],
+        [[-2.0, 1.0, 5.0], [2.5, -1.5, 20.0], [1.0, 3.0, 10.0]],
+    ];
+    for t in tris {
+        let state = RenderState::new(NEAR as f32, FAR as f32).unwrap();
+        let mut lean_frame = Frame::new(W as u32, H as u32);
+        let mut depth = vec![0u16; W as usize * H as usize];
+        let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
+        buf.clear();
+        let mut r: Rasterizer<PerPixel<DefaultRecip>> = Rasterizer::new(state);
+        let a = r
+            .draw_world(&mut lean_frame, &mut buf, &m, &vp, &t, Rgb565::WHITE)
+            .unwrap();
+        let mut frame = Frame::new(W as u32, H as u32);
+        let mut bytes = vec![0u8; W as usize * H as usize * 2];
+        let mut pbuf = Packed::<W16>::new(&mut bytes, W, H).unwrap();
+        pbuf.clear(&state.range);
+        let b = r
+            .draw_world_format(&mut frame, Some(&mut pbuf), &m, &vp, &t, Rgb565::WHITE)
+            .unwrap();
+        assert_eq!(a, b);
+        assert!(a.written > 100);
+        assert!(frame == lean_frame);
+        assert!(depth
+            .iter()
+            .zip(bytes.chunks_exact(2))
+            .all(|(d, b)| *d == u16::from_le_bytes([b[0], b[1]])));
+        let mut zstate = state;
+        zstate.mode = wraster::DepthMode::Z;
+        let mut rz: Rasterizer<PerPixel<DefaultRecip>> = Rasterizer::new(zstate);
+        let mut zframe = Frame::new(W as u32, H as u32);
+        let mut zbytes = vec![0u8; W as usize * H as usize * 2];
+        let mut zbuf = Packed::<Z16>::new(&mut zbytes, W, H).unwrap();
+        zbuf.clear(&state.range);
+        let c = rz
+            .draw_world_format(&mut zframe, Some(&mut zbuf), &m, &vp, &t, Rgb565::WHITE)
+            .unwrap();
+        assert_eq!(c.written, a.written);
+    }
+}
+
+/// D3DVIEWPORT2's clip rectangle: with the clip rectangle `(-0.5, 0.5, 1, 1)` (the middle half of the projected
+/// square) a vertex lands at `X + W/2 + W x/w`, exactly where the default viewport puts the vertex with x and y doubled
+/// (`X + (2x/w + 1) W/2`): the two frames are equal pixel for pixel. A zero-sized clip rectangle is refused.
+#[test]
+fn viewport_clip_rectangle_magnifies() {
+    let m = projection();
+    let full = Viewport::new(0.0, 0.0, W as f32, H as f32);
+    let zoom = Viewport {
+        clip_x: -0.5,
+        clip_y: 0.5,
+        clip_width: 1.0,
+        clip_height: 1.0,
+        ..full
+    };
+    let t = [[-2.5, -1.25, 10.0], [2.5, -1.25, 10.0], [0.0, 1.75, 10.0]];
+    let doubled = t.map(|[x, y, z]| [2.0 * x, 2.0 * y, z]);
+    let draw = |vp: &Viewport, t: &[[f32; 3]; 3]| {
+        let mut frame = Frame::new(W as u32, H as u32);
+        let mut depth = vec![0u16; W as usize * H as usize];
+        let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
+        buf.clear();
+        let mut r: Rasterizer = Rasterizer::new(RenderState::new(NEAR as f32, FAR as f32).unwrap());
+        r.draw_world(&mut frame, &mut buf, &m, vp, t, Rgb565::WHITE)
+            .unwrap();
+        (frame, depth)
+    };
+    let (a, b) = (draw(&zoom, &t), draw(&full, &doubled));
+    let n = a.0.writes.iter().filter(|&&w| w > 0).count();
+    println!(
+        "clip rectangle: {n} px, same as the doubled triangle: {}",
+        a == b
+    );
+    assert!(n > 300 && a == b);
+    let bad = Viewport {
+        clip_width: 0.0,
+        ..full
+    };
+    let mut frame = Frame::new(W as u32, H as u32);
+    let mut depth = vec![0u16; W as usize * H as usize];
+    let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
+    let mut r: Rasterizer = Rasterizer::new(RenderState::new(NEAR as f32, FAR as f32).unwrap());
+    assert!(r
+        .draw_world(&mut frame, &mut buf, &m, &bad, &t, Rgb565::WHITE)
+        .is_err());
 }
