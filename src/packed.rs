@@ -249,7 +249,8 @@ impl ZConst {
 fn linear_z60(zc: &ZConst, t: i64, frac: u32) -> i64 {
     let t = t.max(1) as u64;
     let z = (1i128 << 60) - zc.rz60(t, frac) as i128;
-    let u = div_u128((1u128 << (62 + frac).min(125)) + (t as u128 >> 1), t).min(1 << 100) as i128;
+    // |z| < 2^63 (rz60 is saturated to 2^62) and u <= 2^64 after the clamp, so the product fits i128
+    let u = div_u128((1u128 << (62 + frac).min(125)) + (t as u128 >> 1), t).min(1 << 64) as i128;
     ((z * u) >> 62).clamp(-(1 << 61), 1 << 61) as i64
 }
 

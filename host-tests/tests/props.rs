@@ -39,7 +39,11 @@ fn tri() -> impl Strategy<Value = [Vertex<Rgb565>; 3]> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 400, .. ProptestConfig::default() })]
+    // 400 cases unless PROPTEST_CASES says otherwise (an explicit `cases` would override the environment).
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(400),
+        .. ProptestConfig::default()
+    })]
 
     /// Every triangle either draws inside the buffers or is refused with nothing written; never a panic.
     #[test]
@@ -85,5 +89,46 @@ proptest! {
         let banded = render::<PrevPixel>(&tris, state, W, H, band).unwrap();
         prop_assert_eq!(&whole.0.px, &banded.0.px);
         prop_assert_eq!(&whole.1, &banded.1);
+    }
+
+    /// The packed path keeps the same invariants for every kind of format and primitive: any triangle, line, point or
+    /// wireframe into W16F, Z24 (3 bytes) or reversed Z, with the Quake strategy too, draws inside or is refused with
+    /// nothing written.
+    #[test]
+    fn any_primitive_into_any_format_draws_inside_or_is_refused(t in tri(), near in 0.01f32..10.0, ratio in 1.001f32..1e5, kind in 0u8..4) {
+        fn one<F: wraster::Codec, R: wraster::recip::WSpan>(t: &[Vertex<Rgb565>; 3], state: RenderState, kind: u8) -> Result<(), TestCaseError> {
+            let mut r = wraster::Rasterizer::<R>::new(state);
+            let mut frame = Frame::new(W as u32, H as u32);
+            let mut bytes = vec![0u8; W as usize * H as usize * F::BYTES];
+            let mut buf = wraster::Packed::<F>::new(&mut bytes, W, H).unwrap();
+            buf.clear(&state.range);
+            let cleared = bytes.clone();
+            let mut buf = wraster::Packed::<F>::new(&mut bytes, W, H).unwrap();
+            let out = match kind {
+                0 => r.draw_format(&mut frame, Some(&mut buf), t),
+                1 => r.draw_line_format(&mut frame, Some(&mut buf), &[t[0], t[1]]),
+                2 => r.draw_point_format(&mut frame, Some(&mut buf), &t[2]),
+                _ => r.draw_wireframe_format(&mut frame, Some(&mut buf), t),
+            };
+            match out {
+                Ok(stats) => {
+                    prop_assert!(stats.written <= stats.fragments);
+                    prop_assert_eq!(frame.writes.iter().map(|&n| n as u64).sum::<u64>(), stats.written as u64);
+                }
+                Err(_) => {
+                    prop_assert!(frame.writes.iter().all(|&n| n == 0));
+                    prop_assert!(bytes == cleared);
+                }
+            }
+            Ok(())
+        }
+        let state = match RenderState::new(near, near * ratio) {
+            Ok(s) => s,
+            Err(_) => return Ok(()),
+        };
+        one::<wraster::format::W16F, PerPixel<DefaultRecip>>(&t, state, kind)?;
+        one::<wraster::format::Z24, PerPixel<DefaultRecip>>(&t, state, kind)?;
+        one::<wraster::format::RZ32F, PerPixel<DefaultRecip>>(&t, state, kind)?;
+        one::<wraster::format::W32F, wraster::recip::Quake<8>>(&t, state, kind)?;
     }
 }
