@@ -446,3 +446,88 @@ fn bias_removes_coplanar_fighting_in_every_16_bit_format_and_reversed_z() {
     check::<Z16>(3.0);
     check::<RZ32F>(34.0);
 }
+
+/// All eight comparisons, with depth write on and off, give the same frame and codes on the packed path as on the lean
+/// one (W16, the overdraw scene); on reversed Z they keep their meaning in depth order: `Greater` keeps the farthest
+/// surface, as `Greater` does on W16.
+#[test]
+fn every_comparison_on_the_packed_path() {
+    let scene = Scene::Overdraw;
+    let (n, f) = scene.depth_range();
+    let tris: Vec<_> = scene.tris().collect();
+    for cmp in [
+        Compare::Never,
+        Compare::Less,
+        Compare::Equal,
+        Compare::LessEqual,
+        Compare::Greater,
+        Compare::NotEqual,
+        Compare::GreaterEqual,
+        Compare::Always,
+    ] {
+        for write in [true, false] {
+            let state = RenderState {
+                compare: cmp,
+                depth_write: write,
+                ..RenderState::new(n, f).unwrap()
+            };
+            let (f1, d1, s1) =
+                render::<PerPixel<DefaultRecip>>(&tris, state, WIDTH, HEIGHT, HEIGHT).unwrap();
+            let (f2, d2, s2) =
+                render_format::<W16, PerPixel<DefaultRecip>>(&tris, state, WIDTH, HEIGHT).unwrap();
+            assert_eq!(s1, s2, "{cmp:?} {write}");
+            assert!(
+                f1 == f2 && d1.iter().zip(&d2).all(|(a, b)| *a as u32 == *b),
+                "{cmp:?} {write}"
+            );
+        }
+    }
+    // Reversed Z evaluates every comparison in depth order: after a `Less` pass, a second pass in reverse order with
+    // each comparison shows the same surfaces as W16, except where two surfaces' exact depths are within 2 W16 LSB
+    // (each W16 code is within 1 of exact, so only there can W16 see a tie that reversed Z does not).
+    fn two_pass<F: Codec>(
+        tris: &[[Vertex<Rgb565>; 3]],
+        state: RenderState,
+        cmp: Compare,
+    ) -> (Vec<Rgb565>, u32) {
+        let mut frame = Frame::new(WIDTH as u32, HEIGHT as u32);
+        let mut bytes = vec![0u8; WIDTH as usize * HEIGHT as usize * F::BYTES];
+        let mut buf = Packed::<F>::new(&mut bytes, WIDTH, HEIGHT).unwrap();
+        buf.clear(&state.range);
+        let mut r = Rasterizer::<PerPixel<DefaultRecip>>::new(state);
+        for t in tris {
+            r.draw_format(&mut frame, Some(&mut buf), t).unwrap();
+        }
+        r.state.compare = cmp;
+        let mut second = 0;
+        for t in tris.iter().rev() {
+            let c = t.map(|v| Vertex {
+                color: Rgb565::MAGENTA,
+                ..v
+            });
+            second += r
+                .draw_format(&mut frame, Some(&mut buf), &c)
+                .unwrap()
+                .written;
+        }
+        (frame.px, second)
+    }
+    let state = RenderState::new(n, f).unwrap();
+    let rf = host_tests::reference_frame(&tris, n, f, WIDTH as u32, HEIGHT as u32);
+    let tie = |k: usize| (rf.runner_up[k] - rf.depth[k]) * 65535.0 <= 2.0;
+    for cmp in [
+        Compare::Greater,
+        Compare::GreaterEqual,
+        Compare::LessEqual,
+        Compare::Equal,
+        Compare::NotEqual,
+    ] {
+        let (w, sw) = two_pass::<W16>(&tris, state, cmp);
+        let (rz, _) = two_pass::<RZ32F>(&tris, state, cmp);
+        let differ = (0..w.len()).filter(|&k| w[k] != rz[k] && !tie(k)).count();
+        assert_eq!(differ, 0, "{cmp:?}");
+        if cmp != Compare::Equal {
+            assert!(sw > 1000, "{cmp:?}: the second pass draws");
+        }
+    }
+}
