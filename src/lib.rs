@@ -31,6 +31,35 @@
 //! assert!(stats.written > 100);
 //! # Ok::<(), wraster::Error>(())
 //! ```
+//!
+//! Any depth format of the seeds ([`format`]) renders through [`Packed`] buffers, with Z or W buffering
+//! ([`DepthMode`]), and points, lines and wireframe triangles too:
+//!
+//! ```
+//! use embedded_graphics_core::pixelcolor::Rgb565;
+//! use embedded_graphics_core::prelude::*;
+//! use wraster::format::RZ32F;
+//! use wraster::{DepthMode, Packed, Rasterizer, RenderState, Vertex};
+//!
+//! # struct Screen;
+//! # impl OriginDimensions for Screen { fn size(&self) -> Size { Size::new(32, 16) } }
+//! # impl DrawTarget for Screen {
+//! #     type Color = Rgb565; type Error = core::convert::Infallible;
+//! #     fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(&mut self, _: I) -> Result<(), Self::Error> { Ok(()) }
+//! # }
+//! let mut state = RenderState::new(10.0, 1000.0)?;
+//! state.mode = DepthMode::Z;
+//! let mut bytes = [0u8; 32 * 16 * 4];
+//! let mut depth = Packed::<RZ32F>::new(&mut bytes, 32, 16)?; // reversed float Z, 4 bytes a pixel
+//! depth.clear(&state.range);
+//! let mut r: Rasterizer = Rasterizer::new(state);
+//! let a = Vertex::new(1.5, 1.5, 20.0, Rgb565::RED);
+//! let b = Vertex::new(30.5, 4.5, 900.0, Rgb565::RED);
+//! let c = Vertex::new(6.5, 14.5, 100.0, Rgb565::RED);
+//! assert!(r.draw_format(&mut Screen, Some(&mut depth), &[a, b, c])?.written > 100);
+//! assert!(r.draw_line_format(&mut Screen, Some(&mut depth), &[a, b])?.fragments > 20);
+//! # Ok::<(), wraster::Error>(())
+//! ```
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
