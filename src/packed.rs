@@ -1,7 +1,7 @@
 //! Depth buffers of any [`DepthFormat`], packed 2, 3 or 4 bytes a pixel, and the span loop that fills them.
 //!
 //! Every format goes through the same edge walk and the same screen-linear `T = t 2^F`, `t = W_far / W`
-//! (see [`crate::raster`]). What a pixel stores is computed from it in integers, never in f64:
+//! (see ARCHITECTURE.md). What a pixel stores is computed from it in integers, never in f64:
 //! - W formats ([`Input::W`]) take `u = W / W_far` in Q0.62 from the rasterizer's `W` strategy (a per-pixel reciprocal
 //!   or [`crate::recip::Quake`]);
 //! - Z formats ([`Input::Z`]) take D3D's `[0, 1]` Z, which is affine in `1/W` and so needs no reciprocal:
