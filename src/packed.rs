@@ -379,18 +379,7 @@ impl<R: WSpan> Rasterizer<R> {
         D::Color: PixelColor,
     {
         let res = self.resolve::<F>(depth.is_some())?;
-        let (y0, height, width) = match &depth {
-            Some(d) => (d.y0(), d.height(), d.width()),
-            None => {
-                let b = target.bounding_box();
-                let w = (b.top_left.x.max(0) as u32 + b.size.width).min(u16::MAX as u32);
-                (
-                    b.top_left.y,
-                    b.size.height.min(u16::MAX as u32) as u16,
-                    w as u16,
-                )
-            }
-        };
+        let (y0, height, width) = extent(&depth, target);
         let mut w = match self.prepare(v, (y0, height))? {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
@@ -703,18 +692,7 @@ impl<R: WSpan> Rasterizer<R> {
         D::Color: PixelColor,
     {
         let res = self.resolve::<F>(depth.is_some())?;
-        let (y0, height, width) = match &depth {
-            Some(d) => (d.y0(), d.height(), d.width()),
-            None => {
-                let b = target.bounding_box();
-                let w = (b.top_left.x.max(0) as u32 + b.size.width).min(u16::MAX as u32);
-                (
-                    b.top_left.y,
-                    b.size.height.min(u16::MAX as u32) as u16,
-                    w as u16,
-                )
-            }
-        };
+        let (y0, height, width) = extent(&depth, target);
         let (_, fm, fe) = split(self.state.range.far()).ok_or(Error::NonFinite)?;
         let ctx = DepthCtx {
             far: (fm, fe),
@@ -771,6 +749,22 @@ impl<R: WSpan> Rasterizer<R> {
         }
         stats.fragments = frags;
         Ok(stats)
+    }
+}
+
+/// The rows (first, count) and columns a draw covers: the buffer's, or the target's without one.
+fn extent<F, D: DrawTarget>(depth: &Option<&mut Packed<'_, F>>, target: &D) -> (i32, u16, u16) {
+    match depth {
+        Some(d) => (d.y0, d.height, d.width),
+        None => {
+            let b = target.bounding_box();
+            let w = (b.top_left.x.max(0) as u32 + b.size.width).min(u16::MAX as u32);
+            (
+                b.top_left.y,
+                b.size.height.min(u16::MAX as u32) as u16,
+                w as u16,
+            )
+        }
     }
 }
 
