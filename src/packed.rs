@@ -312,20 +312,20 @@ impl<'a, F: Codec> Packed<'a, F> {
     }
     /// The code at frame pixel `(x, y)`, if it is in this buffer.
     pub fn get(&self, x: i32, y: i32) -> Option<u32> {
-        let r = y.checked_sub(self.y0)?;
-        if x < 0 || x >= self.width as i32 || r < 0 || r >= self.height as i32 {
-            return None;
-        }
-        let k = (r as usize * self.width as usize + x as usize) * F::BYTES;
+        let k = self.offset(x, y)?;
         Some(F::unpack(&self.data[k..k + F::BYTES]))
     }
     fn pixel_mut(&mut self, x: i32, y: i32) -> Option<&mut [u8]> {
+        let k = self.offset(x, y)?;
+        Some(&mut self.data[k..k + F::BYTES])
+    }
+    /// The byte offset of frame pixel `(x, y)`, if it is in this buffer.
+    fn offset(&self, x: i32, y: i32) -> Option<usize> {
         let r = y.checked_sub(self.y0)?;
         if x < 0 || x >= self.width as i32 || r < 0 || r >= self.height as i32 {
             return None;
         }
-        let k = (r as usize * self.width as usize + x as usize) * F::BYTES;
-        Some(&mut self.data[k..k + F::BYTES])
+        Some((r as usize * self.width as usize + x as usize) * F::BYTES)
     }
     fn row_mut(&mut self, y: i32, lo: i32, hi: i32) -> &mut [u8] {
         let r = (y - self.y0) as usize * self.width as usize;
@@ -360,6 +360,18 @@ pub fn resolve<F: Codec>(asked: DepthMode, has_buffer: bool) -> Result<Resolved,
 }
 
 impl<R: WSpan> Rasterizer<R> {
+    /// `n / (f - n)` of the state's depth range for the Z formats: computed when the range changes, not per primitive.
+    fn zconst(&mut self) -> ZConst {
+        match self.zc {
+            Some((range, zc)) if range == self.state.range => zc,
+            _ => {
+                let zc = ZConst::new(&self.state.range);
+                self.zc = Some((self.state.range, zc));
+                zc
+            }
+        }
+    }
+
     /// What a draw into a buffer of format `F` (or into none) does with the state's [`DepthMode`].
     pub fn resolve<F: Codec>(&self, has_buffer: bool) -> Result<Resolved, Error> {
         resolve::<F>(self.state.mode, has_buffer)
@@ -387,7 +399,7 @@ impl<R: WSpan> Rasterizer<R> {
         let (_, fm, fe) = split(self.state.range.far()).ok_or(Error::NonFinite)?;
         let far = (fm, fe);
         let frac = w.frac;
-        let zc = ZConst::new(&self.state.range);
+        let zc = self.zconst();
         let mut lin = (F::INPUT == Input::LinearZ)
             .then(|| Plane::solve(w.t_vertex.map(|t| linear_z60(&zc, t, frac)), &w.geom));
         let ctx = DepthCtx {
@@ -396,7 +408,13 @@ impl<R: WSpan> Rasterizer<R> {
             frac,
             t_lo: w.span.t_lo,
             t_hi: w.span.t_hi,
-            bias: self.format_bias::<F>(&w.geom.p, &w.t_vertex, frac, (w.span.t_lo, w.span.t_hi)),
+            bias: self.format_bias::<F>(
+                &zc,
+                &w.geom.p,
+                &w.t_vertex,
+                frac,
+                (w.span.t_lo, w.span.t_hi),
+            ),
             cmp: self.state.compare,
             write: self.state.depth_write,
         };
@@ -460,6 +478,7 @@ impl<R: WSpan> Rasterizer<R> {
     #[cfg(feature = "bias")]
     fn format_bias<F: Codec>(
         &self,
+        zc: &ZConst,
         p: &[Sub; 3],
         t: &[i64; 3],
         frac: u32,
@@ -470,14 +489,13 @@ impl<R: WSpan> Rasterizer<R> {
             return 0;
         }
         let (_, fm, fe) = split(st.range.far()).unwrap_or((false, 1, 0));
-        let zc = ZConst::new(&st.range);
         // T is at most 2^61 here; t_max may saturate to u64::MAX: clamp in u64.
         let codes = t.map(|t| {
             let tc = (t.max(0) as u64).clamp(range.0, range.1.max(range.0));
             let q = match F::INPUT {
                 Input::W => exact_u(tc, frac),
                 Input::Z => zc.z60(tc, frac),
-                Input::LinearZ => linear_z60(&zc, tc as i64, frac).clamp(0, 1 << 60) as u64,
+                Input::LinearZ => linear_z60(zc, tc as i64, frac).clamp(0, 1 << 60) as u64,
             };
             F::code(q, (fm, fe)) as f32
         });
@@ -485,7 +503,14 @@ impl<R: WSpan> Rasterizer<R> {
     }
     #[cfg(not(feature = "bias"))]
     #[inline(always)]
-    fn format_bias<F: Codec>(&self, _: &[Sub; 3], _: &[i64; 3], _: u32, _: (u64, u64)) -> i32 {
+    fn format_bias<F: Codec>(
+        &self,
+        _: &ZConst,
+        _: &[Sub; 3],
+        _: &[i64; 3],
+        _: u32,
+        _: (u64, u64),
+    ) -> i32 {
         0
     }
 }
@@ -514,8 +539,7 @@ impl<R: WSpan> Rasterizer<R> {
         D::Color: PixelColor,
     {
         let s = self.setup(core::array::from_ref(v))?;
-        let zc = ZConst::new(&self.state.range);
-        let z = linear_z60(&zc, s.t[0], s.frac);
+        let z = linear_z60(&self.zconst(), s.t[0], s.frac);
         let line = Line1 {
             t0: s.t[0] as u64,
             dt: 0,
@@ -578,7 +602,8 @@ impl<R: WSpan> Rasterizer<R> {
             });
         }
         let range = (1u64 << s.frac, self.state.range.t_max(s.frac));
-        let bias = self.format_bias::<F>(&s.p, &s.t, s.frac, range);
+        let zc = self.zconst();
+        let bias = self.format_bias::<F>(&zc, &s.p, &s.t, s.frac, range);
         let mut stats = Stats::default();
         for (a, b) in [(0, 1), (1, 2), (2, 0)] {
             stats += self.line_inner::<F, D>(
@@ -648,7 +673,7 @@ impl<R: WSpan> Rasterizer<R> {
             )
         };
         let (t0, dt) = step(ta, tb);
-        let zc = ZConst::new(&self.state.range);
+        let zc = self.zconst();
         let (z0, dz) = if F::INPUT == Input::LinearZ {
             step(linear_z60(&zc, ta, frac), linear_z60(&zc, tb, frac))
         } else {
@@ -696,7 +721,7 @@ impl<R: WSpan> Rasterizer<R> {
         let (_, fm, fe) = split(self.state.range.far()).ok_or(Error::NonFinite)?;
         let ctx = DepthCtx {
             far: (fm, fe),
-            zc: ZConst::new(&self.state.range),
+            zc: self.zconst(),
             frac,
             t_lo: 1 << frac,
             t_hi: self.state.range.t_max(frac),

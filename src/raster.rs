@@ -153,6 +153,9 @@ pub struct Rasterizer<R: WSpan = PerPixel<DefaultRecip>> {
     /// The render state used by the next draws.
     pub state: RenderState,
     pub(crate) recip: R,
+    /// The Z constant of the packed path's Z formats, with the range it was computed for (once per range, not per
+    /// primitive; see `crate::packed`).
+    pub(crate) zc: Option<(crate::DepthRange, crate::packed::ZConst)>,
 }
 
 impl<R: WSpan> Rasterizer<R> {
@@ -161,6 +164,7 @@ impl<R: WSpan> Rasterizer<R> {
         Rasterizer {
             state,
             recip: R::default(),
+            zc: None,
         }
     }
 

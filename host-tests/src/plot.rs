@@ -155,13 +155,7 @@ pub fn step_plot(rows: &[Row], n: f64, f: f64, path: &std::path::Path) {
             .draw(&mut disp)
             .unwrap();
     }
-    let img = disp.to_rgb_output_image(
-        &OutputSettingsBuilder::new()
-            .scale(1)
-            .pixel_spacing(0)
-            .build(),
-    );
-    img.save_png(path).unwrap();
+    save(&disp, path);
 }
 
 /// A point of the error-against-time plot.

@@ -221,7 +221,6 @@ fn linear_z_trick_errs_inside_triangles_within_kantorovich() {
             let d = fd / p.t;
             let code = codes[(p.y as u32 * W as u32 + p.x as u32) as usize];
             let stored = LZ16::fraction(code, nd, fd);
-            let truth = (d - nd) / (fd - nd);
             // the stored linear depth's relative error, as a depth: (n + s (f - n)) / d - 1
             let rel = (nd + stored * (fd - nd)) / d - 1.0;
             let slack = (half_step::<LZ16>(code, nd, fd) + 2f64.powi(-33)) * (fd - nd) / d;
@@ -231,7 +230,6 @@ fn linear_z_trick_errs_inside_triangles_within_kantorovich() {
             );
             max_rel = max_rel.max(rel / kant);
             max_codes = max_codes.max(code as i64 - LZ16::encode(d, nd, fd) as i64);
-            let _ = truth;
             px += 1;
         }
     }
