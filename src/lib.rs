@@ -72,6 +72,7 @@ pub mod clip;
 mod depth;
 mod edge;
 mod error;
+mod fast;
 mod fixed;
 pub mod format;
 pub mod packed;

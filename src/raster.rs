@@ -20,7 +20,7 @@ use crate::edge::{Edge, Sub};
 use crate::fixed::{div_u128, round_shift, split, to_fixed};
 #[cfg(feature = "gouraud")]
 use crate::recip::Inv;
-use crate::recip::{normalise, DefaultRecip, PerPixel, SpanRecip, SpanWalker, WSpan};
+use crate::recip::{normalise, Fast, SpanRecip, SpanWalker, WSpan};
 use crate::state::{Compare, DepthMode};
 use crate::state::{Cull, RenderState, MAX_T_LOG2};
 use crate::Error;
@@ -149,7 +149,7 @@ pub(crate) fn div_round(n: i128, d: i128) -> i128 {
 
 /// Draws triangles into a colour target and a depth buffer, with `W` strategy `R` (a per-pixel reciprocal
 /// [`SpanRecip`], or [`crate::recip::Quake`] for the packed formats).
-pub struct Rasterizer<R: WSpan = PerPixel<DefaultRecip>> {
+pub struct Rasterizer<R: WSpan = Fast> {
     /// The render state used by the next draws.
     pub state: RenderState,
     pub(crate) recip: R,
@@ -605,6 +605,24 @@ impl<D: DrawTarget> Runs<'_, D> {
         }
         Ok(())
     }
+    /// Pixels `a..b` fail (none when `a == b`): flush the run before `a`.
+    #[inline(always)]
+    pub(crate) fn fail_many(&mut self, a: usize, b: usize) -> Result<(), Error> {
+        if a < b {
+            self.fails += (b - a) as u32;
+            let start = core::mem::replace(&mut self.start, b);
+            if start < a {
+                fill(
+                    self.target,
+                    self.lo + start as i32,
+                    self.lo + a as i32,
+                    self.j,
+                    self.color,
+                )?;
+            }
+        }
+        Ok(())
+    }
     #[inline(always)]
     pub(crate) fn finish(&mut self, n: usize) -> Result<(), Error> {
         if self.start < n {
@@ -675,7 +693,17 @@ fn span<R: SpanRecip, D: DrawTarget>(
     let last = t.wrapping_add((dt as u64).wrapping_mul(n as u64 - 1));
     let in_range = |v: u64| v >= ctx.t_lo && v <= ctx.t_hi;
     let (tame, smooth) = SpanWalker::classify(t, dt, n as u32);
-    if tame && in_range(t) && in_range(last) {
+    if R::FAST_W16
+        && n >= crate::fast::MIN_SPAN
+        && tame
+        && in_range(t)
+        && in_range(last)
+        && cmp == Compare::Less
+        && write
+        && ctx.bias() == 0
+    {
+        crate::fast::span(row, t, dt, 94 - ctx.shift_base, runs)?;
+    } else if tame && in_range(t) && in_range(last) {
         recip.begin_span(smooth);
         // The comparison is chosen once per span: the default (Less) gets its own loop, the rest share one.
         if cmp == Compare::Less && ctx.bias() == 0 {

@@ -233,6 +233,8 @@ pub trait SpanRecip: Default {
     const NAME: &'static str;
     /// Largest relative error of `1/t` at any pixel (derived; a test sweeps spans and asserts it).
     const MAX_REL_ERROR: f64;
+    /// Whether W16 spans with the `Less` test take the fast tier's loop (`crate::fast`) instead of this reciprocal.
+    const FAST_W16: bool = false;
     /// Before the first pixel of a span; `smooth` as defined at [`SMOOTH_SHIFT`].
     #[inline(always)]
     fn begin_span(&mut self, _smooth: bool) {}
@@ -260,6 +262,32 @@ impl<R: Recip32> SpanRecip for PerPixel<R> {
         R::recip(m)
     }
 }
+
+/// The fast tier (the default): W16 spans drawn with `Less` and depth write take the 32-bit loop of the fast tier
+/// (a reciprocal carried along the span, the depth test ahead of it; bound [`crate::fast::FAST_MAX_REL_ERROR`], under
+/// `2^-11` of a code); everything else (other comparisons, bias, spans crossing a depth plane, the packed formats) uses
+/// [`DefaultRecip`] per pixel, like the exact tier.
+#[derive(Default)]
+pub struct Fast;
+
+impl SpanRecip for Fast {
+    const NAME: &'static str = "fast";
+    const MAX_REL_ERROR: f64 =
+        if crate::fast::FAST_MAX_REL_ERROR > PerPixel::<DefaultRecip>::MAX_REL_ERROR {
+            crate::fast::FAST_MAX_REL_ERROR
+        } else {
+            PerPixel::<DefaultRecip>::MAX_REL_ERROR
+        };
+    const FAST_W16: bool = true;
+    #[inline(always)]
+    fn recip(&mut self, m: u32) -> u32 {
+        DefaultRecip::recip(m)
+    }
+}
+
+/// The exact tier: the piecewise-linear seed and one Newton-Raphson step at every pixel (correctly rounded codes
+/// except within `2^-12` LSB of a tie).
+pub type Exact = PerPixel<DefaultRecip>;
 
 /// Seeded from the previous pixel of the span: one Newton-Raphson step, no table, no normalisation of the seed.
 ///

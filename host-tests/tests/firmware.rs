@@ -12,7 +12,7 @@ use std::collections::HashMap;
 
 use embedded_graphics::pixelcolor::IntoStorage;
 use host_tests::{have, render, run_board};
-use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
+use wraster::recip::{Exact, Fast, PrevPixel, SpanRecip};
 use wraster::scenes::{Scene, HEIGHT, WIDTH};
 use wraster::RenderState;
 
@@ -73,7 +73,8 @@ fn boards_render_the_hosts_frames_bit_for_bit() {
         return;
     }
     let mut host = HashMap::new();
-    host_runs::<PerPixel<DefaultRecip>>(&mut host);
+    host_runs::<Fast>(&mut host);
+    host_runs::<Exact>(&mut host);
     host_runs::<PrevPixel>(&mut host);
 
     for (board, bands) in [("qemu-m4", 1), ("qemu-m0", 30), ("qemu-rv32", 1)] {

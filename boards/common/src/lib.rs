@@ -287,7 +287,10 @@ pub fn run_all<R: SpanRecip, C: Counter>(
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
     let mut ok = true;
-    for scene in &SCENES {
+    for scene in SCENES
+        .iter()
+        .filter(|s| option_env!("ONLY").is_none_or(|o| o == s.name))
+    {
         match run_scene::<R, C>(scene, color, depth, counter) {
             Ok(run) => print(format_args!("{}", bench_line(board, core, &run))),
             Err(e) => {

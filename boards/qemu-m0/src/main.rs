@@ -14,7 +14,7 @@
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use panic_semihosting as _;
-use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
+use wraster::recip::{Exact, Fast, PrevPixel, SpanRecip};
 use wraster_board::{run_all, run_scene, SysTick, HEIGHT, SCENES, WIDTH};
 
 /// Rows per band: the largest multiple of 8 whose two buffers leave room for the stack in 16 KiB.
@@ -34,13 +34,8 @@ fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick
 fn band_overhead(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
     let half = WIDTH as usize * BAND_ROWS / 2;
     for scene in &SCENES {
-        let r30 = run_scene::<PerPixel<DefaultRecip>, _>(scene, color, depth, counter);
-        let r60 = run_scene::<PerPixel<DefaultRecip>, _>(
-            scene,
-            &mut color[..half],
-            &mut depth[..half],
-            counter,
-        );
+        let r30 = run_scene::<Fast, _>(scene, color, depth, counter);
+        let r60 = run_scene::<Fast, _>(scene, &mut color[..half], &mut depth[..half], counter);
         match (r30, r60) {
             (Ok(a), Ok(b)) if a.hash == b.hash => hprintln!(
                 "band-overhead board=qemu-m0 scene={} bands={}/{} instructions={}/{} instr_per_extra_band={}",
@@ -66,7 +61,8 @@ fn main() -> ! {
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
-    let ok = all::<PerPixel<DefaultRecip>>(COLOR, DEPTH, &mut counter)
+    let ok = all::<Fast>(COLOR, DEPTH, &mut counter)
+        & all::<Exact>(COLOR, DEPTH, &mut counter)
         & all::<PrevPixel>(COLOR, DEPTH, &mut counter)
         & band_overhead(COLOR, DEPTH, &mut counter);
     debug::exit(if ok {

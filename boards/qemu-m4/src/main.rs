@@ -15,8 +15,8 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use panic_semihosting as _;
 #[cfg(not(feature = "size-probe"))]
-use wraster::recip::PrevPixel;
-use wraster::recip::{DefaultRecip, PerPixel, SpanRecip};
+use wraster::recip::{Exact, PrevPixel};
+use wraster::recip::{Fast, SpanRecip};
 use wraster_board::{run_all, SysTick, HEIGHT, WIDTH};
 
 const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
@@ -33,10 +33,12 @@ fn main() -> ! {
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 40, 1);
-    let ok = all::<PerPixel<DefaultRecip>>(COLOR, DEPTH, &mut counter);
+    let ok = all::<Fast>(COLOR, DEPTH, &mut counter);
     // `--features size-probe` links the default path only, to measure the library's share of .text (README).
     #[cfg(not(feature = "size-probe"))]
-    let ok = ok & all::<PrevPixel>(COLOR, DEPTH, &mut counter);
+    let ok = ok
+        & all::<Exact>(COLOR, DEPTH, &mut counter)
+        & all::<PrevPixel>(COLOR, DEPTH, &mut counter);
     // `--features f32-div` adds the f32-division reciprocal (one VDIV on this core), for comparison (README).
     #[cfg(feature = "f32-div")]
     let ok = ok & all::<PerPixel<wraster::recip::F32Div>>(COLOR, DEPTH, &mut counter);

@@ -11,7 +11,7 @@
 
 use riscv_rt::entry;
 use riscv_semihosting::{debug, hprintln};
-use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
+use wraster::recip::{Exact, Fast, PrevPixel, SpanRecip};
 use wraster_board::{run_all, Counter, HEIGHT, WIDTH};
 
 const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
@@ -42,7 +42,8 @@ fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16]) -> bool {
 fn main() -> ! {
     // The frame lives on the stack (riscv-rt gives it the top of the 16 MiB RAM): no `static mut`, no unsafe.
     let (mut color, mut depth) = ([0u16; PIXELS], [0u16; PIXELS]);
-    let ok = all::<PerPixel<DefaultRecip>>(&mut color, &mut depth)
+    let ok = all::<Fast>(&mut color, &mut depth)
+        & all::<Exact>(&mut color, &mut depth)
         & all::<PrevPixel>(&mut color, &mut depth);
     debug::exit(if ok {
         debug::EXIT_SUCCESS

@@ -20,7 +20,7 @@ use rp2040_hal::clocks::{init_clocks_and_plls, Clock};
 use rp2040_hal::fugit::RateExtU32;
 use rp2040_hal::gpio::{FunctionSpi, Pins};
 use rp2040_hal::{entry, pac, Sio, Spi, Timer, Watchdog};
-use wraster::recip::{DefaultRecip, PerPixel};
+use wraster::recip::Fast;
 use wraster_board::{run_scene_with, NoCounter, SCENES, WIDTH};
 
 /// The second-stage boot loader for the Pico's W25Q080 flash.
@@ -84,7 +84,7 @@ fn main() -> ! {
     let terrain = SCENES.iter().find(|s| s.name == "terrain").unwrap();
     let mut color = [0u16; WIDTH as usize * BAND_ROWS];
     let mut depth = [0u16; WIDTH as usize * BAND_ROWS];
-    let _ = run_scene_with::<PerPixel<DefaultRecip>, _>(
+    let _ = run_scene_with::<Fast, _>(
         terrain,
         &mut color,
         &mut depth,

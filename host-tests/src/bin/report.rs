@@ -292,7 +292,7 @@ fn w_format<F: Codec>(out: &mut Vec<Combo>, scenes: &[Case], stiff: &[Case]) {
         stiff,
     ));
     out.push(measure::<F, PerPixel<DefaultRecip>>(
-        "lerp64+1nr (default)",
+        "lerp64+1nr",
         None,
         scenes,
         stiff,
@@ -476,7 +476,14 @@ fn main() {
 
     let mut combos = vec![
         measure_with::<W16>(
-            "lerp64+1nr (default), lean W16 path",
+            "fast tier (default), lean W16 path",
+            Some("fast"),
+            &scenes,
+            &stiff,
+            render_lean::<wraster::recip::Fast>,
+        ),
+        measure_with::<W16>(
+            "lerp64+1nr (exact tier), lean W16 path",
             Some("lerp64"),
             &scenes,
             &stiff,
@@ -643,7 +650,7 @@ fn main() {
         combos[0].scenes.pixels, combos[0].stiff.pixels
     );
     let _ = writeln!(md, "## Step against distance (near 10, far 10000)\n\nMeasured steps (dots, from neighbouring codes) over the analytic limits of shared/notes/precision.md (lines). `cargo run --release -p host-tests --bin precision -- --near 10 --far 10000` prints the numbers.\n\n![step against distance](step_10_10000.png)\n");
-    let _ = writeln!(md, "## Terrain depth error of the default (W16, lerp64 seed + 1 Newton-Raphson step)\n\nPer pixel, |decoded W - exact W| / W on a log scale from 1e-6 (blue) to 1e-1 (red); largest {heat_max:.2e}. This is the W16 quantisation itself (half a code is 0.5 / 65535 of W_far, so the relative error grows towards the eye, 0.0076 at W = 10): the reciprocal adds no code error on this scene (every pixel where it shows the reference's surface holds the exact code).\n\n![terrain error](terrain_error.png)\n");
+    let _ = writeln!(md, "## Terrain depth error of the exact tier (W16, lerp64 seed + 1 Newton-Raphson step)\n\nPer pixel, |decoded W - exact W| / W on a log scale from 1e-6 (blue) to 1e-1 (red); largest {heat_max:.2e}. This is the W16 quantisation itself (half a code is 0.5 / 65535 of W_far, so the relative error grows towards the eye, 0.0076 at W = 10): the reciprocal adds no code error on this scene (every pixel where it shows the reference's surface holds the exact code).\n\n![terrain error](terrain_error.png)\n");
     let _ = writeln!(md, "## Stiff suite\n");
     for c in &stiff {
         let _ = writeln!(

@@ -1,0 +1,497 @@
+//! The fast tier's W16 span loop ([`crate::recip::Fast`]): 32-bit arithmetic per pixel, a derived bound of well
+//! under one code, and the depth test ahead of the reciprocal wherever the stored depth already rules a pixel out.
+//!
+//! **Scaling.** The W16 code is `c = round(65535 / t) = round(2^(F+16) / V)` with `V = T * 65536/65535`: folding the
+//! 65535 into the walked value makes the code a power-of-two shift of the reciprocal. `V` and its step are formed
+//! once per span (`x / 65535 = x (2^-16 + 2^-32 + 2^-48 + ...)`, shifts and adds, after normalising `T` to 63 bits:
+//! error below `2^-59` relative) and walked in 64 bits (`ADDS`/`ADC`), so no error builds up along the span. The
+//! high word is `tau`, normalised per binade: in `[2^31, 2^32)` when `T` falls along the span (`DOWN`), in
+//! `[2^30, 2^31)` when it rises (`UP`), so leaving the binade is the top bit changing (one flag test per pixel).
+//! Then `x = 2^X / tau` (`X = 61` down, `60` up) lies in `(2^29, 2^30]`, and `c = (x + 2^(s-1)) >> s` with
+//! `s = X + 16 - F - lz` (`lz` the normalising shift): two instructions.
+//!
+//! **The reciprocal.** On a binade where `tau` changes by at most `2^-8` of itself per pixel (*chained*), `x` is
+//! carried from pixel to pixel: the seed `x_k + (x_k - x_(k-1))` (a linear extrapolation, relative error at most
+//! `2 r^2 (1 + 2^-6)` for a relative step `r <= 2^-8`, plus three times the carried error), then one Newton-Raphson
+//! step `x' = x - x (tau x - 1)` in 32-bit products (`UMULL`, `SMMUL`), which squares the seed's error and adds the
+//! products' truncation. Steeper binades take a fresh reciprocal per pixel (a 128-cell piecewise-linear seed and one
+//! step). [`FAST_MAX_REL_ERROR`] is the bound over both, derived below and swept in
+//! the tests; times 65535 it is the largest code error: `2^-11.4` LSB.
+//!
+//! **The test before the reciprocal.** With the `Less` comparison, a pixel whose stored code `s` satisfies
+//! `2^G / tau >= s` (`G = X - s`) fails whatever the rounding, since the computed code errs by far less than 1/2.
+//! With `A = tau >> 17` (so `tau < (A + 1) 2^17`) that is implied by `(A + 1) s <= 2^(G - 17)`, and that by
+//! `A s <= 2^(G-17) (1 - 2^-13) - 1` (`A >= 2^13`): one multiply and a compare. After the first failing pixel the loop only runs this test; the first pixel it cannot rule out gets a
+//! fresh reciprocal and the real test. So a pixel is written exactly when its computed code is below the stored
+//! one, as in the plain loop, and hidden fragments cost no reciprocal.
+
+use embedded_graphics_core::draw_target::DrawTarget;
+
+use crate::raster::Runs;
+use crate::Error;
+
+/// Largest relative error of the fast tier's `x` against the exact `2^X / tau_exact` (`tau_exact` the unrounded
+/// high word of the exact `V`), over both modes:
+/// - fresh: a 128-cell chord seed (`2^-14.8`) and one step: `< 2^-27.6` (see `fresh61`);
+/// - chained: seed error `e_s <= 2 r^2 (1 + 2^-6) + 3 e` with `r <= 2^-8`, so `e_s < 2^-14.9` for any `e <= 2^-20`;
+///   the step gives `e_s^2 + 2^-29` (truncated `tau x` product: one unit of `2^-29` in the residual) `+ 2^-29`
+///   (truncated `SMMUL`) `< 2^-27.6`; the fixed point of `e = (2^-14.9 + 3e)^2 + 2^-28` stays below `2^-27.5`;
+/// - `tau` itself: the truncated high word is below the exact one by less than one unit of `2^-30` relative.
+///
+/// Sum: `2^-27.5 + 2^-30 < 2^-27.2`.
+pub const FAST_MAX_REL_ERROR: f64 = 6.5e-9; // 2^-27.2 = 6.46e-9
+
+/// Shorter spans take the per-pixel reciprocal (the exact tier's loop): below this the fast loop's span set-up costs
+/// more than it saves (measured on the M4 board's small scene, whose spans are 3 pixels long).
+pub(crate) const MIN_SPAN: usize = 8;
+
+/// Per-binade constants: the code shift and rounding, and the prefilter's limit.
+struct Bin {
+    s: u32,
+    round: u32,
+    lim: u32,
+}
+
+impl Bin {
+    #[inline(always)]
+    fn new<const UP: bool>(frac: u32, lz: i32) -> Bin {
+        let x_bits = if UP { 60 } else { 61 };
+        let s = x_bits + 16 - frac as i32 - lz;
+        // G = X - s; the exact code is 2^G / tau.
+        let g = x_bits - s;
+        // (A + 1) s <= 2^(G-17) is implied by A s <= L (1 - 2^-13) - 1, since A >= 2^13 (tau >= 2^30), so
+        // (A + 1) s <= A s (1 + 2^-13): the compare needs no +1.
+        let lim = if g < 17 {
+            0
+        } else {
+            let l = 1u32 << (g - 17).min(31);
+            (l - (l >> 13)).saturating_sub(1)
+        };
+        if s >= 32 {
+            // x <= 2^30 (1 + 2^-27): every code on this binade is round(x / 2^s) = 0, which x >> 31 gives.
+            Bin {
+                s: 31,
+                round: 0,
+                lim,
+            }
+        } else {
+            Bin {
+                s: s.max(1) as u32,
+                round: 1 << (s.max(1) - 1),
+                lim,
+            }
+        }
+    }
+    #[inline(always)]
+    fn code(&self, x: i32) -> u16 {
+        ((x as u32).wrapping_add(self.round) >> self.s) as u16
+    }
+    /// Whether the stored code `stored` rules out any computed code below it (`Less` fails for sure).
+    #[inline(always)]
+    fn fails(&self, tau: u32, stored: u16) -> bool {
+        (tau >> 17) * stored as u32 <= self.lim
+    }
+}
+
+/// Cells of the fresh seed: 128 over `d = m / 2^32` in `[1/2, 1)`.
+const CELLS: usize = 128;
+
+/// Per cell `[a, b)`: `(2^61/m` at `a` lowered by half the chord's largest gap, the drop across the cell`)`, both in
+/// units of `2^-29` (the `X = 61` scale of `x`). The chord of the convex `1/d` lies above it by at most
+/// `(b - a)^2 / (4 a^2 b)` relative (at `sqrt(a b)`), so the halved chord errs by at most `(b-a)^2/(8 a^2 b) < 2^-17.9`.
+const fn seed_table() -> [(u32, u32); CELLS] {
+    let mut t = [(0u32, 0u32); CELLS];
+    let mut k = 0;
+    while k < CELLS {
+        let a = 0.5 + k as f64 / 256.0;
+        let b = a + 1.0 / 256.0;
+        let q = (1u64 << 29) as f64;
+        let gap = (b - a) * (b - a) / (4.0 * a * a * b) / b; // in units of 1/d at b's scale: an upper bound
+        t[k] = (
+            ((1.0 / a - gap / 2.0) * q + 0.5) as u32,
+            ((1.0 / a - 1.0 / b) * q + 0.5) as u32,
+        );
+        k += 1;
+    }
+    t
+}
+
+/// `2^61 / m` for `m` in `[2^31, 2^32)`: the table's chord at 9 bits of the position in the cell (one 32-bit
+/// multiply: the drop is below `2^23`), then one Newton-Raphson step. Seed error: the chord `2^-17.9`, the
+/// position truncated to 9 bits (`drop / 2^9 < 2^23 / 2^9` units, `2^-15` relative to `x > 2^29`), the entries' rounding:
+/// below `2^-14.8`; after the step `(2^-14.8)^2 + 2^-28 < 2^-27.6`.
+#[inline(always)]
+fn fresh61(m: u32) -> i32 {
+    const T: [(u32, u32); CELLS] = seed_table();
+    let (y, drop) = T[((m >> 24) & 127) as usize];
+    let u = (m >> 15) & 511;
+    newton::<false>(m, (y - ((drop * u) >> 9)) as i32)
+}
+
+/// `2^X / tau`, fresh (no previous pixel).
+#[inline(always)]
+fn fresh<const UP: bool>(tau: u32) -> i32 {
+    // Up: 2^60 / tau = 2^61 / (2 tau), and 2 tau is in [2^31, 2^32).
+    fresh61(if UP { tau << 1 } else { tau })
+}
+
+/// One Newton-Raphson step on `2^X / tau` from the seed `xs`.
+#[inline(always)]
+fn newton<const UP: bool>(tau: u32, xs: i32) -> i32 {
+    let p = ((tau as u64 * xs as u32 as u64) >> 32) as u32; // tau xs / 2^32, about 2^(X - 32)
+    let e = (p << if UP { 4 } else { 3 }) as i32; // (tau xs / 2^X - 1) 2^32, small
+    xs.wrapping_sub(((xs as i64 * e as i64) >> 32) as i32)
+}
+
+/// The first-order difference `x_(k+1) - x_k = -x r`, `r = delta / tau = delta x / 2^X`, to start the extrapolation.
+#[inline(always)]
+fn slope<const UP: bool>(x: i32, delta: i32) -> i32 {
+    let shift = if UP { 28 } else { 29 };
+    let r32 = (delta as i64 * x as i64) >> shift;
+    (-(x as i64 * r32) >> 32) as i32
+}
+
+/// Largest per-pixel change of `tau` (its high word) for chaining: `r <= 2^-8`.
+const CHAIN_DOWN: u64 = 1 << (23 + 32);
+const CHAIN_UP: u64 = 1 << (22 + 32);
+
+/// Draws one `Less`, depth-write span whose every pixel is in range and whose step is tame (`|dt| <= T_min / 4`).
+/// `t0` is the first pixel's `T` (`t 2^frac`), `dt` the step. Fails are reported to `runs`, passing runs filled.
+#[inline(always)]
+pub(crate) fn span<D: DrawTarget>(
+    row: &mut [u16],
+    t0: u64,
+    dt: i64,
+    frac: u32,
+    runs: &mut Runs<'_, D>,
+) -> Result<(), Error> {
+    // T normalised to [2^62, 2^63), then V = T + T/65535 (error below 4 units of 2^62).
+    let l0 = t0.leading_zeros() as i32 - 1;
+    let tn = t0 << l0;
+    let dn = dt << l0;
+    let v = tn + (tn >> 16) + (tn >> 32) + (tn >> 48);
+    let dv = dn + (dn >> 16) + (dn >> 32) + (dn >> 48);
+    if dt >= 0 {
+        // tau in [2^30, 2^31): bit 62 on top.
+        let (v, dv, lz) = if v >> 63 != 0 {
+            (v >> 1, dv >> 1, l0 - 1)
+        } else {
+            (v, dv, l0)
+        };
+        walk::<true, D>(row, v, dv, lz, frac, runs)
+    } else {
+        let (v, dv, lz) = if v >> 63 == 0 {
+            (v << 1, dv << 1, l0 + 1)
+        } else {
+            (v, dv, l0)
+        };
+        walk::<false, D>(row, v, dv, lz, frac, runs)
+    }
+}
+
+/// The pixels of a span, binade by binade. State between pixels: in a passing run (`x`, `dx` current) or not.
+#[inline(always)]
+fn walk<const UP: bool, D: DrawTarget>(
+    row: &mut [u16],
+    mut v: u64,
+    mut dv: i64,
+    mut lz: i32,
+    frac: u32,
+    runs: &mut Runs<'_, D>,
+) -> Result<(), Error> {
+    let n = row.len();
+    let (mut x, mut dx) = (0i32, 0i32);
+    let mut in_run = false;
+    let mut k = 0usize;
+    let crossed = left_binade::<UP>;
+    'bins: loop {
+        let b = Bin::new::<UP>(frac, lz);
+        let chain = dv.unsigned_abs() <= if UP { CHAIN_UP } else { CHAIN_DOWN };
+        loop {
+            if k >= n {
+                break 'bins;
+            }
+            if in_run {
+                // Passing run: reciprocal, code, test, store (one loop per mode, chosen per binade).
+                let (failed, cross) = if chain {
+                    run::<UP, true>(&mut row[k..], &mut k, &mut v, dv, &mut x, &mut dx, &b)
+                } else {
+                    run::<UP, false>(&mut row[k..], &mut k, &mut v, dv, &mut x, &mut dx, &b)
+                };
+                if cross {
+                    renormalise::<UP>(&mut v, &mut dv, &mut lz, &mut x, &mut dx);
+                    continue 'bins;
+                }
+                if failed {
+                    // pixel k fails: close the run before it
+                    in_run = false;
+                    runs.fail(k)?;
+                    k += 1;
+                    v = v.wrapping_add(dv as u64);
+                    if crossed(v) {
+                        renormalise::<UP>(&mut v, &mut dv, &mut lz, &mut x, &mut dx);
+                        continue 'bins;
+                    }
+                }
+            } else {
+                // Not in a run: the prefilter alone, until a pixel it cannot rule out.
+                let start = k;
+                let (mut maybe, mut left) = (false, false);
+                let mut it = row[k..].iter();
+                let mut vv = v;
+                for stored in it.by_ref() {
+                    if !b.fails((vv >> 32) as u32, *stored) {
+                        maybe = true;
+                        break;
+                    }
+                    vv = vv.wrapping_add(dv as u64);
+                    if left_binade::<UP>(vv) {
+                        left = true;
+                        break;
+                    }
+                }
+                v = vv;
+                // The pixel that broke the loop was consumed by the iterator unless the row ended.
+                k = n - it.len() - usize::from(maybe);
+                runs.fail_many(start, k)?;
+                if left {
+                    renormalise::<UP>(&mut v, &mut dv, &mut lz, &mut x, &mut dx);
+                    continue 'bins;
+                }
+                if !maybe {
+                    continue;
+                }
+                // Pixel k: a fresh reciprocal and the real test.
+                let tau = (v >> 32) as u32;
+                x = fresh::<UP>(tau);
+                dx = slope::<UP>(x, (dv >> 32) as i32);
+                let c = b.code(x);
+                if c < row[k] {
+                    row[k] = c;
+                    in_run = true;
+                } else {
+                    runs.fail(k)?;
+                }
+                k += 1;
+                v = v.wrapping_add(dv as u64);
+                if crossed(v) {
+                    renormalise::<UP>(&mut v, &mut dv, &mut lz, &mut x, &mut dx);
+                    continue 'bins;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The passing run from `row[0]` (pixel `*k` of the span): until a pixel fails (`(true, _)`, `*k` at it, `v` not
+/// stepped past it), `tau` leaves the binade (`(_, true)`, `*k` and `v` past the last pixel drawn), or the row ends.
+#[inline(always)]
+fn run<const UP: bool, const CHAIN: bool>(
+    row: &mut [u16],
+    k: &mut usize,
+    v: &mut u64,
+    dv: i64,
+    x: &mut i32,
+    dx: &mut i32,
+    b: &Bin,
+) -> (bool, bool) {
+    let (mut vv, mut xx, mut dd) = (*v, *x, *dx);
+    let mut out = (false, false);
+    let n = row.len();
+    let mut it = row.iter_mut();
+    for stored in it.by_ref() {
+        let tau = (vv >> 32) as u32;
+        let xn = if CHAIN {
+            newton::<UP>(tau, xx.wrapping_add(dd))
+        } else {
+            fresh::<UP>(tau)
+        };
+        dd = xn.wrapping_sub(xx);
+        xx = xn;
+        let c = b.code(xx);
+        if c >= *stored {
+            out.0 = true;
+            break;
+        }
+        *stored = c;
+        vv = vv.wrapping_add(dv as u64);
+        if left_binade::<UP>(vv) {
+            out.1 = true;
+            break;
+        }
+    }
+    // The failing pixel was consumed by the iterator but not drawn.
+    *k += n - it.len() - usize::from(out.0);
+    (*v, *x, *dx) = (vv, xx, dd);
+    out
+}
+
+/// Whether stepping `v` left the binade: the top bit set (up) or cleared (down).
+#[inline(always)]
+fn left_binade<const UP: bool>(v: u64) -> bool {
+    if UP {
+        (v as i64) < 0
+    } else {
+        (v as i64) >= 0
+    }
+}
+
+/// `tau` left its binade: shift `v` and its step by one, and rescale `x` (and its difference) to the new `tau`.
+#[cold]
+fn renormalise<const UP: bool>(v: &mut u64, dv: &mut i64, lz: &mut i32, x: &mut i32, dx: &mut i32) {
+    if UP {
+        *v >>= 1;
+        *dv >>= 1;
+        *lz -= 1;
+        *x <<= 1;
+        *dx <<= 1;
+    } else {
+        *v <<= 1;
+        *dv <<= 1;
+        *lz += 1;
+        *x >>= 1;
+        *dx >>= 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rnd(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
+    /// The fresh reciprocal over every 2^7-th `m` of `[2^31, 2^32)` and both ends of every cell, two-sided, against
+    /// the exact `2^61 / m`: within `2^-27.6` (its derivation, at `fresh61`), which is inside the tier's bound.
+    #[test]
+    fn fresh_reciprocal_holds_its_bound() {
+        let bound = 2f64.powf(-27.6);
+        assert!(bound < FAST_MAX_REL_ERROR);
+        let mut worst = 0.0f64;
+        let mut check = |m: u32| {
+            let exact = 2f64.powi(61) / m as f64;
+            worst = worst.max((fresh61(m) as f64 / exact - 1.0).abs());
+        };
+        let mut m: u64 = 1 << 31;
+        while m < 1 << 32 {
+            check(m as u32);
+            m += 1 << 7;
+        }
+        for k in 0..CELLS as u64 {
+            let lo = (1u64 << 31) | (k << 24);
+            check(lo as u32);
+            check((lo + (1 << 24) - 1) as u32);
+        }
+        std::println!("fresh: worst {:.2} bits, bound 27.6", -worst.log2());
+        assert!(worst <= bound, "{worst:e}");
+    }
+
+    /// Chained spans: `tau` walked as the loop walks it (64 bits, renormalised per binade), `x` carried by the
+    /// extrapolated seed and one step wherever the binade allows chaining, fresh elsewhere; every pixel's `x` against
+    /// the exact `2^X / tau` of the exact 64-bit value, within [`FAST_MAX_REL_ERROR`]. Returns (pixels, chained).
+    fn sweep<const UP: bool>() -> (u64, u64) {
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let (mut pixels, mut chained, mut worst) = (0u64, 0u64, 0.0f64);
+        for _ in 0..3000 {
+            // v normalised as the span set-up leaves it, a step up to a quarter of v, spans up to 400 px.
+            let top = if UP { 1u64 << 62 } else { 1u64 << 63 };
+            let mut v = top + rnd(&mut state) % top;
+            let mag = (v >> 2) >> (rnd(&mut state) % 40);
+            let mut dv = (rnd(&mut state) % (mag + 1)) as i64;
+            if !UP {
+                dv = -dv;
+            }
+            let mut x = 0i32;
+            let mut dx = 0i32;
+            let mut have = false;
+            for _ in 0..1 + rnd(&mut state) % 400 {
+                // Only tame spans reach the loop: |dt| <= T / 4 at every pixel (here, at the same scale).
+                if dv.unsigned_abs() > v >> 2 {
+                    break;
+                }
+                let chain = dv.unsigned_abs() <= if UP { CHAIN_UP } else { CHAIN_DOWN };
+                let tau = (v >> 32) as u32;
+                let xn = if have && chain {
+                    newton::<UP>(tau, x.wrapping_add(dx))
+                } else if have {
+                    fresh::<UP>(tau)
+                } else {
+                    let f = fresh::<UP>(tau);
+                    dx = slope::<UP>(f, (dv >> 32) as i32);
+                    x = f.wrapping_sub(dx); // so that dx = xn - x below
+                    f
+                };
+                chained += u64::from(have && chain);
+                have = true;
+                dx = xn.wrapping_sub(x);
+                x = xn;
+                let exact =
+                    if UP { 2f64.powi(60) } else { 2f64.powi(61) } / (v as f64 / 2f64.powi(32));
+                worst = worst.max((x as f64 / exact - 1.0).abs());
+                pixels += 1;
+                v = v.wrapping_add(dv as u64);
+                if left_binade::<UP>(v) {
+                    let mut lz = 0;
+                    renormalise::<UP>(&mut v, &mut dv, &mut lz, &mut x, &mut dx);
+                }
+            }
+        }
+        std::println!(
+            "chained spans ({}): {pixels} pixels, {chained} chained, worst {:.2} bits, bound {:.2}",
+            if UP { "up" } else { "down" },
+            -worst.log2(),
+            -FAST_MAX_REL_ERROR.log2()
+        );
+        assert!(worst <= FAST_MAX_REL_ERROR, "{worst:e}");
+        (pixels, chained)
+    }
+
+    #[test]
+    fn chained_and_fresh_spans_hold_the_bound() {
+        for (pixels, chained) in [sweep::<true>(), sweep::<false>()] {
+            assert!(chained > pixels / 4, "the sweep must exercise chaining");
+        }
+    }
+
+    /// The prefilter never rules out a pixel whose computed code is below the stored one: for random `tau` on a
+    /// binade and stored codes around the computed one, `fails` implies `code >= stored`.
+    #[test]
+    fn prefilter_is_conservative() {
+        let mut state = 0x9E37_79B9_7F4A_7C15_u64;
+        let mut tested = 0;
+        for _ in 0..200_000 {
+            let up = rnd(&mut state).is_multiple_of(2);
+            let frac = 30 + (rnd(&mut state) % 32) as u32;
+            let lz = (rnd(&mut state) % 34) as i32;
+            // Spans in range have t >= 1, so codes <= 65535: the shift is at least 15 (x <= 2^30).
+            let shift = if up { 60 } else { 61 } + 16 - frac as i32 - lz;
+            if shift < 15 {
+                continue;
+            }
+            let (b, tau, x) = if up {
+                let tau = (1u32 << 30) | (rnd(&mut state) as u32 >> 2);
+                (Bin::new::<true>(frac, lz), tau, fresh::<true>(tau))
+            } else {
+                let tau = (1u32 << 31) | (rnd(&mut state) as u32 >> 1);
+                (Bin::new::<false>(frac, lz), tau, fresh::<false>(tau))
+            };
+            let code = b.code(x) as i32;
+            for d in -3..=3 {
+                let stored = (code + d).clamp(0, 65535) as u16;
+                if b.fails(tau, stored) {
+                    tested += 1;
+                    assert!(
+                        code >= stored as i32,
+                        "tau {tau} code {code} stored {stored}"
+                    );
+                }
+            }
+        }
+        assert!(tested > 50_000, "{tested}");
+    }
+}
