@@ -71,6 +71,46 @@ impl Edge {
         }
     }
 
+    /// [`Edge::new`] for a triangle whose snapped box is under 127 px each way (the fast tier's small triangles):
+    /// the same walk, set up in 32-bit arithmetic relative to the box's origin pixel `(ox, oy)`
+    /// (`ox = floor(xmin / 256)`, `oy = floor(ymin / 256)`).
+    ///
+    /// Relative coordinates are below `2^15`, so `|A|, |B| < 2^15` and both terms of
+    /// `N = A (128 - a.x) + B (256 (j - oy) + 128 - a.y) - bias` are below `2^30`: `N` fits `i32`, and the two
+    /// divisions are 32-bit (one `SDIV` each on the Cortex-M4, where the 64-bit ones are library calls). Moving the
+    /// origin by `ox` pixels adds `256 A ox` to `N`, so the quotient moves by `ox` (left edges) or `-ox` (right edges)
+    /// and the remainder is unchanged: the walk is the one [`Edge::new`] sets up.
+    pub fn new_small(a: Sub, b: Sub, j: i32, ox: i32, oy: i32) -> Edge {
+        let (ax, ay) = (a.x - 256 * ox, a.y - 256 * oy);
+        let (bx, by) = (b.x - 256 * ox, b.y - 256 * oy);
+        let a_ = ay - by;
+        let b_ = bx - ax;
+        let top_left = a_ > 0 || (a_ == 0 && b_ > 0);
+        let bias = i32::from(!top_left);
+        let n = a_ * (128 - ax) + b_ * (256 * (j - oy) + 128 - ay) - bias;
+        let s = 256 * b_;
+        if a_ == 0 {
+            return Edge {
+                side: Side::Flat,
+                q: n as i64,
+                r: 0,
+                d: 0,
+                step_q: s as i64,
+                step_r: 0,
+            };
+        }
+        let d = 256 * a_.abs();
+        let q = n.div_euclid(d) as i64;
+        Edge {
+            side: if a_ > 0 { Side::Left } else { Side::Right },
+            q: if a_ > 0 { q - ox as i64 } else { q + ox as i64 },
+            r: n.rem_euclid(d) as i64,
+            d: d as i64,
+            step_q: s.div_euclid(d) as i64,
+            step_r: s.rem_euclid(d) as i64,
+        }
+    }
+
     /// Moves to the next row.
     #[inline(always)]
     pub fn step(&mut self) {

@@ -392,7 +392,7 @@ impl<R: WSpan> Rasterizer<R> {
     {
         let res = self.resolve::<F>(depth.is_some())?;
         let (y0, height, width) = extent(&depth, target);
-        let mut w = match self.prepare(v, (y0, height))? {
+        let mut w = match self.prepare(v, (y0, height), false)? {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
         };

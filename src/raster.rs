@@ -197,10 +197,13 @@ impl<R: WSpan> Rasterizer<R> {
     /// Snaps, checks, culls and clips a triangle to the buffer's rows, and solves its `t` plane.
     /// `Ok(Err(stats))` when there is nothing to walk (culled, or no row in the buffer).
     /// `rows` is the buffer's first frame row and its height.
+    /// `fast`: the fast tier's set-up for small triangles (32-bit edges, the plane from a reciprocal of the area,
+    /// [`Plane::solve_fast`]) where it applies; the exact set-up otherwise.
     pub(crate) fn prepare<C>(
         &self,
         v: &[Vertex<C>; 3],
         rows: (i32, u16),
+        fast: bool,
     ) -> Result<Result<Walk, Stats>, Error> {
         let s = self.setup(v)?;
         let [p0, p1, p2] = s.p;
@@ -227,21 +230,47 @@ impl<R: WSpan> Rasterizer<R> {
             return Ok(Err(Stats::default()));
         }
         let xmin = p[0].x.min(p[1].x).min(p[2].x);
+        let ymin = p[0].y.min(p[1].y).min(p[2].y);
         let geom = Geom {
             p,
             area: area.unsigned_abs() as i128,
             i_ref: (xmin >> SUBPIXEL_BITS) as i64,
             j0,
         };
-        let t = Plane::solve(order.map(|k| s.t[k]), &geom);
-        Ok(Ok(Walk {
-            frac: s.frac,
-            t_vertex: order.map(|k| s.t[k]),
-            edges: [
+        let t_or = order.map(|k| s.t[k]);
+        // Small: every vertex within 127 px (minus a pixel for the origin's offset) of the box's origin pixel.
+        let small = fast && {
+            let xmax = p[0].x.max(p[1].x).max(p[2].x);
+            let ymax = p[0].y.max(p[1].y).max(p[2].y);
+            xmax - xmin < 126 << SUBPIXEL_BITS && ymax - ymin < 126 << SUBPIXEL_BITS
+        };
+        let fast_plane = if small {
+            Plane::solve_fast(t_or, &geom)
+        } else {
+            None
+        };
+        let t = match fast_plane {
+            Some(t) => t,
+            None => Plane::solve(t_or, &geom),
+        };
+        let edges = if small {
+            let (ox, oy) = (xmin >> SUBPIXEL_BITS, ymin >> SUBPIXEL_BITS);
+            [
+                Edge::new_small(p[0], p[1], j0, ox, oy),
+                Edge::new_small(p[1], p[2], j0, ox, oy),
+                Edge::new_small(p[2], p[0], j0, ox, oy),
+            ]
+        } else {
+            [
                 Edge::new(p[0], p[1], j0),
                 Edge::new(p[1], p[2], j0),
                 Edge::new(p[2], p[0], j0),
-            ],
+            ]
+        };
+        Ok(Ok(Walk {
+            frac: s.frac,
+            t_vertex: t_or,
+            edges,
             geom,
             order,
             j1,
@@ -281,7 +310,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         D::Color: PixelColor,
     {
         let (cmp, write) = self.w16_test()?;
-        let mut w = match self.prepare(v, (depth.y0(), depth.height()))? {
+        let mut w = match self.prepare(v, (depth.y0(), depth.height()), R::FAST_W16)? {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
         };
@@ -333,7 +362,7 @@ impl<R: SpanRecip> Rasterizer<R> {
     {
         let (cmp, write) = self.w16_test()?;
         let s_t = self.setup(v)?.t;
-        let mut w = match self.prepare(v, (depth.y0(), depth.height()))? {
+        let mut w = match self.prepare(v, (depth.y0(), depth.height()), false)? {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
         };
@@ -449,6 +478,50 @@ impl Plane {
             sy: div_round(gy * 256, g.area) as i64,
         }
     }
+    /// The fast tier's plane of `T` for a small triangle (box under 127 px), from one 64-bit reciprocal of the
+    /// doubled area instead of three exact 128-bit divisions; `None` where its error bound does not hold (then the
+    /// exact solve runs).
+    ///
+    /// The vertices' `T` (below `2^61`) are rounded to `T' = T >> 16` (at most `2^15` off each, so at most `2^15` at any
+    /// point inside the triangle, a convex combination of them). With edge vectors below `2^15` sub-pixels the
+    /// gradients `g` of `T'` times the doubled area fit `i64` (`< 2^61`). `inv = floor(2^62 / area)`, and a step in
+    /// `T` per pixel is `floor(g inv / 2^38)`, below the exact `g 2^24 / area` by at most `eps = |g| 2^-38 + 1`.
+    /// The value at the reference pixel is `T'_0 2^16` plus the steps times its offset from vertex 0 (at most 128 px
+    /// each way), and a covered pixel is at most 127 px further: at most `510 eps + 1` from the steps.
+    /// Total, at any covered pixel: `2^15 + 510 (|g| 2^-38 + 1) + 1 < |g| 2^-29 + 2^16`. This is accepted when
+    /// `|gx| + |gy| <= T_min / 2^5` and `T_min >= 2^51` (`T_min` the smallest vertex `T`, a lower bound of every covered
+    /// pixel's): then the error is below `T_min (2^-34 + 2^-35) < 2^-33` relative, the exact solve's own bound on
+    /// these triangles. Steps must also fit: `|g| < area 2^38`.
+    pub(crate) fn solve_fast(v: [i64; 3], g: &Geom) -> Option<Plane> {
+        let [p0, p1, p2] = g.p;
+        let t_min = v[0].min(v[1]).min(v[2]);
+        if t_min < 1 << 51 {
+            return None;
+        }
+        let tp = v.map(|t| (t + (1 << 15)) >> 16);
+        let (d1, d2) = (tp[1] - tp[0], tp[2] - tp[0]);
+        let (e1x, e1y) = ((p1.x - p0.x) as i64, (p1.y - p0.y) as i64);
+        let (e2x, e2y) = ((p2.x - p0.x) as i64, (p2.y - p0.y) as i64);
+        let gx = d1 * e2y - d2 * e1y;
+        let gy = d2 * e1x - d1 * e2x;
+        let area = g.area as u64;
+        let (ax, ay) = (gx.unsigned_abs(), gy.unsigned_abs());
+        if ax + ay > (t_min >> 5) as u64 || ax >= area << 38 || ay >= area << 38 {
+            return None;
+        }
+        let inv = (1u64 << 62) / area;
+        let step = |g: i64| ((g as i128 * inv as i128) >> 38) as i64;
+        let (sx, sy) = (step(gx), step(gy));
+        let rx = 256 * g.i_ref + 128 - p0.x as i64;
+        let ry = 256 * g.j0 as i64 + 128 - p0.y as i64;
+        let off = (sx as i128 * rx as i128 + sy as i128 * ry as i128) >> 8;
+        Some(Plane {
+            row: (tp[0] << 16).wrapping_add(off as i64),
+            sx,
+            sy,
+        })
+    }
+
     #[inline(always)]
     pub(crate) fn at(&self, di: i64) -> i64 {
         self.row.wrapping_add(self.sx.wrapping_mul(di))
