@@ -10,10 +10,14 @@
 //! Per row, a left edge (`A > 0`) admits `i >= -floor(N / D)` and a right edge (`A < 0`) admits `i <= floor(N / D)`, with
 //! `N(j) = B (256 j + 128) + C - bias + 128 A` and `D = 256 |A|`. `N` grows by `256 B` a row, so `floor(N / D)` is
 //! walked exactly with a quotient and a remainder (a DDA): no division per row or pixel, only at setup.
-//! A horizontal edge admits a whole row or none: `N(j) >= 0`.
+//! A horizontal edge admits a whole row or none, and only the row whose centres lie exactly on it can be refused
+//! (a bottom edge, which is not top-left): [`flat_rows`] folds that into the triangle's row range at set-up, so the
+//! row walk skips horizontal edges.
 //!
 //! Ranges: with vertices inside the guard band (`|x|, |y| < 2^20` sub-pixels) `|A|, |B| < 2^21`, `|C| < 2^42`, and
-//! `|N| < 2^44`: every quantity fits `i64` with room to spare (see ARCHITECTURE.md).
+//! `|N| < 2^44`: the set-up runs in `i64` (see ARCHITECTURE.md). What it leaves fits `i32`: the quotient `q` is a
+//! column bound of a row the triangle spans, so inside the guard band (`|q| <= 2^12 + 1`); `0 <= r < D = 256 |A| < 2^29`;
+//! `|floor(256 B / D)| < 2^21`. So the walk per row is 32-bit.
 
 /// A sub-pixel position.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -26,48 +30,50 @@ pub(crate) struct Sub {
 pub(crate) enum Side {
     Left,
     Right,
+    /// Horizontal: no bound on a row of the triangle's range (see [`flat_rows`]).
     Flat,
 }
 
-/// One edge, walked row by row: `N = q D + r`, `0 <= r < D` (for a flat edge, `q` holds `N` itself).
+/// One edge, walked row by row: `N = q D + r`, `0 <= r < D`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Edge {
     pub side: Side,
-    q: i64,
-    r: i64,
-    d: i64,
-    step_q: i64,
-    step_r: i64,
+    q: i32,
+    r: i32,
+    d: i32,
+    step_q: i32,
+    step_r: i32,
 }
 
 impl Edge {
+    const FLAT: Edge = Edge {
+        side: Side::Flat,
+        q: 0,
+        r: 0,
+        d: 0,
+        step_q: 0,
+        step_r: 0,
+    };
+
     /// The edge `a -> b` of a triangle with positive doubled area, positioned at row `j`.
     pub fn new(a: Sub, b: Sub, j: i32) -> Edge {
         let a_ = (a.y - b.y) as i64;
         let b_ = (b.x - a.x) as i64;
-        let c = -(a_ * a.x as i64 + b_ * a.y as i64);
-        let top_left = a_ > 0 || (a_ == 0 && b_ > 0);
-        let bias = i64::from(!top_left);
-        let n = b_ * (256 * j as i64 + 128) + c - bias + 128 * a_;
-        let s = 256 * b_;
         if a_ == 0 {
-            return Edge {
-                side: Side::Flat,
-                q: n,
-                r: 0,
-                d: 0,
-                step_q: s,
-                step_r: 0,
-            };
+            return Edge::FLAT;
         }
+        let top_left = a_ > 0;
+        let bias = i64::from(!top_left);
+        let n = a_ * (128 - a.x as i64) + b_ * (256 * j as i64 + 128 - a.y as i64) - bias;
+        let s = 256 * b_;
         let d = 256 * a_.abs();
         Edge {
             side: if a_ > 0 { Side::Left } else { Side::Right },
-            q: n.div_euclid(d),
-            r: n.rem_euclid(d),
-            d,
-            step_q: s.div_euclid(d),
-            step_r: s.rem_euclid(d),
+            q: n.div_euclid(d) as i32,
+            r: n.rem_euclid(d) as i32,
+            d: d as i32,
+            step_q: s.div_euclid(d) as i32,
+            step_r: s.rem_euclid(d) as i32,
         }
     }
 
@@ -85,29 +91,21 @@ impl Edge {
         let (bx, by) = (b.x - 256 * ox, b.y - 256 * oy);
         let a_ = ay - by;
         let b_ = bx - ax;
-        let top_left = a_ > 0 || (a_ == 0 && b_ > 0);
-        let bias = i32::from(!top_left);
+        if a_ == 0 {
+            return Edge::FLAT;
+        }
+        let bias = i32::from(a_ < 0);
         let n = a_ * (128 - ax) + b_ * (256 * (j - oy) + 128 - ay) - bias;
         let s = 256 * b_;
-        if a_ == 0 {
-            return Edge {
-                side: Side::Flat,
-                q: n as i64,
-                r: 0,
-                d: 0,
-                step_q: s as i64,
-                step_r: 0,
-            };
-        }
         let d = 256 * a_.abs();
-        let q = n.div_euclid(d) as i64;
+        let q = n.div_euclid(d);
         Edge {
             side: if a_ > 0 { Side::Left } else { Side::Right },
-            q: if a_ > 0 { q - ox as i64 } else { q + ox as i64 },
-            r: n.rem_euclid(d) as i64,
-            d: d as i64,
-            step_q: s.div_euclid(d) as i64,
-            step_r: s.rem_euclid(d) as i64,
+            q: if a_ > 0 { q - ox } else { q + ox },
+            r: n.rem_euclid(d),
+            d,
+            step_q: s.div_euclid(d),
+            step_r: s.rem_euclid(d),
         }
     }
 
@@ -124,12 +122,26 @@ impl Edge {
 
     /// The bound this edge puts on the current row, as a half-open column range `[lo, hi)`.
     #[inline(always)]
-    pub fn bound(&self) -> (i64, i64) {
+    pub fn bound(&self) -> (i32, i32) {
         match self.side {
-            Side::Left => (-self.q, i64::MAX),
-            Side::Right => (i64::MIN, self.q + 1),
-            Side::Flat if self.q >= 0 => (i64::MIN, i64::MAX),
-            Side::Flat => (0, 0),
+            Side::Left => (-self.q, i32::MAX),
+            Side::Right => (i32::MIN, self.q + 1),
+            Side::Flat => (i32::MIN, i32::MAX),
         }
     }
+}
+
+/// The rows `(first, last)` of a triangle with positive doubled area (`p` oriented), from the rows whose centre lies
+/// in its vertices' y-range, less the row whose centres lie exactly on a horizontal bottom edge: with `A = 0` and
+/// `B < 0` (interior above) the edge is not top-left, and its `N = B (256 j + 128 - y) - 1` is negative exactly from
+/// that row down. A horizontal top edge (`B > 0`) admits every row of the range, its own included.
+pub(crate) fn flat_rows(p: &[Sub; 3], (first, mut last): (i32, i32)) -> (i32, i32) {
+    for k in 0..3 {
+        let (a, b) = (p[k], p[(k + 1) % 3]);
+        if a.y == b.y && b.x < a.x && (a.y - 128).rem_euclid(256) == 0 && (a.y - 128) / 256 == last
+        {
+            last -= 1;
+        }
+    }
+    (first, last)
 }

@@ -223,7 +223,7 @@ impl<R: WSpan> Rasterizer<R> {
         let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
         let p = order.map(|k| s.p[k]);
 
-        let (j_first, j_last) = rows_of(&p);
+        let (j_first, j_last) = crate::edge::flat_rows(&p, rows_of(&p));
         let j0 = j_first.max(rows.0);
         let j1 = j_last.min(rows.0 + rows.1 as i32 - 1);
         if j0 > j1 {
@@ -552,13 +552,13 @@ impl Walk {
     /// The covered columns `[lo, hi)` of the current row inside `[0, width)`, if any.
     #[inline(always)]
     pub(crate) fn row(&self, width: u16) -> Option<(i32, i32)> {
-        let (mut lo, mut hi) = (0i64, width as i64);
+        let (mut lo, mut hi) = (0i32, width as i32);
         for e in &self.edges {
             let (l, h) = e.bound();
             lo = lo.max(l);
             hi = hi.min(h);
         }
-        (lo < hi).then_some((lo as i32, hi as i32))
+        (lo < hi).then_some((lo, hi))
     }
     #[inline(always)]
     pub(crate) fn next_row(&mut self) {

@@ -392,3 +392,63 @@ fn frame_target_reports_writes_outside() {
     });
     assert!(r.is_err());
 }
+
+/// Horizontal edges whose row of centres lies exactly on them (the only rows a horizontal edge can refuse: a
+/// bottom edge is not top-left) and just off them, at the top and the bottom of triangles of both windings and both
+/// strategies' set-ups (the fast tier's small triangles and the general one): coverage equal to the reference.
+#[test]
+fn horizontal_edges_on_pixel_centres_match_reference() {
+    let mut checked = 0;
+    for dy in [0.0f32, 1.0 / 512.0, -1.0 / 512.0] {
+        for (w, h) in [(5.0f32, 4.0f32), (40.0, 30.0), (150.0, 60.0)] {
+            for x0 in [3.5f32, 3.25, 4.0] {
+                let y = 10.5 + dy;
+                let shapes = [
+                    // flat top, flat bottom
+                    [(x0, y), (x0 + w, y), (x0 + w / 3.0, y + h)],
+                    [(x0, y + h), (x0 + w, y + h), (x0 + w / 2.0, y)],
+                ];
+                for s in shapes {
+                    for flip in [false, true] {
+                        let mut v = s.map(|(x, y)| Vertex::new(x, y, 50.0, Rgb565::RED));
+                        if flip {
+                            v.swap(1, 2);
+                        }
+                        for strategy in 0..2 {
+                            let mut state = RenderState::new(1.0, 1000.0).unwrap();
+                            state.compare = Compare::Always;
+                            let (ww, hh) = (200u16, 80u16);
+                            let mut frame = Frame::new(ww as u32, hh as u32);
+                            let mut depth = vec![W16_FAR; ww as usize * hh as usize];
+                            let mut buf = DepthBuffer::new(&mut depth, ww, hh).unwrap();
+                            if strategy == 0 {
+                                Rasterizer::<wraster::recip::Fast>::new(state)
+                                    .draw(&mut frame, &mut buf, &v)
+                                    .unwrap();
+                            } else {
+                                Rasterizer::<wraster::recip::Exact>::new(state)
+                                    .draw(&mut frame, &mut buf, &v)
+                                    .unwrap();
+                            }
+                            let want = reference_tri(
+                                &v.map(|q| (q.x, q.y, q.rhw)),
+                                1.0,
+                                1000.0,
+                                ww as i32,
+                                0..hh as i32,
+                            )
+                            .unwrap();
+                            let mut expect = vec![0u32; frame.writes.len()];
+                            for p in &want {
+                                expect[p.y as usize * ww as usize + p.x as usize] = 1;
+                            }
+                            assert_eq!(frame.writes, expect, "{v:?} strategy {strategy}");
+                            checked += want.len();
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 50_000, "{checked}");
+}
