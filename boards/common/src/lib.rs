@@ -276,7 +276,8 @@ pub fn run_scene_with<R: SpanRecip, C: Counter>(
     })
 }
 
-/// Runs every standard scene with reciprocal `R` and prints its `bench` line (or an `error` line) through `print`;
+/// Runs every standard scene (or only the one named by the build-time environment variable `ONLY`, for profiles:
+/// `ONLY=small cargo run --release`) with reciprocal `R` and prints its `bench` line (or an `error` line) through `print`;
 /// `false` when any scene failed.
 pub fn run_all<R: SpanRecip, C: Counter>(
     board: &str,

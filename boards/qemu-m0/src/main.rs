@@ -14,8 +14,12 @@
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use panic_semihosting as _;
-use wraster::recip::{Exact, Fast, PrevPixel, SpanRecip};
-use wraster_board::{run_all, run_scene, SysTick, HEIGHT, SCENES, WIDTH};
+#[cfg(not(feature = "size-probe"))]
+use wraster::recip::{Exact, PrevPixel};
+use wraster::recip::{Fast, SpanRecip};
+use wraster_board::{run_all, SysTick, HEIGHT, WIDTH};
+#[cfg(not(feature = "size-probe"))]
+use wraster_board::{run_scene, SCENES};
 
 /// Rows per band: the largest multiple of 8 whose two buffers leave room for the stack in 16 KiB.
 const BAND_ROWS: usize = 8;
@@ -31,6 +35,7 @@ fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick
 /// The cost of banding, measured on this core: every scene drawn again in 60 bands of 4 rows; the extra
 /// instructions over the 30-band run, divided by the 30 extra bands, are what one band costs (triangle setup
 /// repeated for triangles spanning both halves, the span walk restarted, the binning test).
+#[cfg(not(feature = "size-probe"))]
 fn band_overhead(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
     let half = WIDTH as usize * BAND_ROWS / 2;
     for scene in &SCENES {
@@ -61,7 +66,10 @@ fn main() -> ! {
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
-    let ok = all::<Fast>(COLOR, DEPTH, &mut counter)
+    let ok = all::<Fast>(COLOR, DEPTH, &mut counter);
+    // `--features size-probe` runs the default strategy only (profiles, cycle estimates: boards/tools/cycles.py).
+    #[cfg(not(feature = "size-probe"))]
+    let ok = ok
         & all::<Exact>(COLOR, DEPTH, &mut counter)
         & all::<PrevPixel>(COLOR, DEPTH, &mut counter)
         & band_overhead(COLOR, DEPTH, &mut counter);

@@ -1,0 +1,120 @@
+#!/usr/bin/env python3
+"""Estimated cycles beside the boards' instruction counts: `cycles.py BOARD [SCENE ...]` (BOARD qemu-m4 or qemu-m0;
+default scenes big overdraw small terrain). For each scene it builds the board with only the default strategy and only
+that scene (`--features size-probe`, `ONLY=<scene>`), runs it under QEMU with the insncount plugin (insncount.c in this
+folder; built here if missing), weights every executed instruction by its class from the core's timing table, and
+prints, last for each scene,
+  cycles board=<b> scene=<s> instructions=<n> instr_per_px=.. instr_per_fragment=.. instr_per_tri=.. cpi=.. est_cycles_per_px=.. est_cycles_per_fragment=.. est_cycles_per_tri=..
+`instructions` is the board's own count for the draw calls (its bench line); the estimate multiplies it by the
+cycles per instruction of the draw code (instructions outside the board crate, the start-up code, the clears and the
+formatting). These are ESTIMATES: QEMU counts instructions, not cycles; the tables do not model flash or RAM wait
+states, bus contention, or pipeline refills beyond the branch penalty; a conditional branch counts as taken for the
+share of its executions its fall-through did not follow.
+Tables: Cortex-M4 Technical Reference Manual, instruction timings (branch penalty P = 2: taken 3, not taken 1; SDIV and
+UDIV 12, their worst case; LDR 2, STR 1, LDM/STM/PUSH/POP 1 + n; VDIV 14; VMLA/VFMA 3). Cortex-M0+ Technical
+Reference Manual (DDI0484C, table 3.1) with the single-cycle multiplier the RP2040 has (MULS 1; loads and stores 2; taken
+branch 2, BL 3, BX/BLX 2; PUSH/POP/LDM/STM 1 + n). The QEMU M0 board is a Cortex-M0 (taken branches one cycle more
+there): the M0+ table is used because the RP2040 is the M0+ this crate targets."""
+import os, re, subprocess, sys
+
+here = os.path.dirname(os.path.abspath(__file__))
+boards = os.path.dirname(here)
+board = sys.argv[1]
+scenes = sys.argv[2:] or ['big', 'overdraw', 'small', 'terrain']
+core = {'qemu-m4': 'm4', 'qemu-m0': 'm0p'}[board]
+target = {'m4': 'thumbv7em-none-eabihf', 'm0p': 'thumbv6m-none-eabi'}[core]
+qemu = {'m4': ['qemu-system-arm', '-cpu', 'cortex-m4', '-machine', 'mps2-an386'],
+        'm0p': ['qemu-system-arm', '-machine', 'microbit']}[core]
+plugin = os.path.join('/tmp', 'wraster-insncount.so')
+if not os.path.exists(plugin):
+    subprocess.run(['cc', '-shared', '-DQEMU_PLUGIN_VERSION=4', '-fPIC', '-O2', '-o', plugin,
+                    os.path.join(here, 'insncount.c')], check=True)
+tools = [os.path.join(r, f) for r, _, fs in os.walk(os.path.expanduser('~/.rustup/toolchains')) for f in fs if f == 'llvm-objdump']
+objdump = tools[0] if tools else 'llvm-objdump'
+
+
+def cycles_of(mn, ops, taken):
+    """Cycles of one execution of instruction `mn ops`; `taken` is the share of executions that branched."""
+    m = mn.split('.')[0]
+    regs = lambda: len(re.findall(r'\b(r\d+|lr|pc|sp|r\d+-r\d+)\b', ops.split('{')[1])) if '{' in ops else 1
+    if core == 'm4':
+        p = 2
+        if m in ('b', 'bl', 'blx', 'bx') or (m.startswith('b') and len(m) <= 3 and m not in ('bic', 'bfi', 'bfc')) or m in ('cbz', 'cbnz'):
+            uncond = m in ('b', 'bl', 'blx', 'bx')
+            return 1 + p if uncond else 1 + p * taken
+        if m in ('sdiv', 'udiv'):
+            return 12
+        if m.startswith('ldm') or m.startswith('stm') or m in ('push', 'pop'):
+            return 1 + regs() + (p if m == 'pop' and 'pc' in ops else 0)
+        if m.startswith('ldr') or m.startswith('vldr'):
+            return 2
+        if m in ('vdiv', 'vsqrt'):
+            return 14
+        if m in ('vmla', 'vmls', 'vfma', 'vfms', 'vnmla', 'vnmls'):
+            return 3
+        if m.startswith('vpush') or m.startswith('vpop') or m.startswith('vldm') or m.startswith('vstm'):
+            return 1 + regs()
+        return 1
+    # Cortex-M0+
+    if m == 'bl':
+        return 3
+    if m in ('bx', 'blx'):
+        return 2
+    if m == 'b':
+        return 2
+    if m.startswith('b') and len(m) <= 3 and m not in ('bic', 'bics'):
+        return 1 + taken
+    if m.startswith('ldm') or m.startswith('stm') or m in ('push', 'pop'):
+        return 1 + regs() + (2 if m == 'pop' and 'pc' in ops else 0)
+    if m.startswith('ldr') or m.startswith('str'):
+        return 2
+    return 1
+
+
+for scene in scenes:
+    env = dict(os.environ, ONLY=scene, CARGO_TARGET_DIR='/tmp/wraster-cycles')
+    subprocess.run(['cargo', 'build', '--release', '--quiet', '--features', 'size-probe'],
+                   cwd=os.path.join(boards, board), env=env, check=True)
+    elf = f'/tmp/wraster-cycles/{target}/release/wraster-{board}'
+    counts = f'/tmp/wraster-cycles-{board}-{scene}.txt'
+    out = subprocess.run(qemu + ['-nographic', '-icount', 'shift=0', '-semihosting-config', 'enable=on,target=native',
+                                 '-kernel', elf, '-plugin', f'{plugin},out={counts}'],
+                         capture_output=True, text=True, check=True).stdout
+    bench = [l for l in out.splitlines() if l.startswith('bench ')][0]
+    f = dict(kv.split('=', 1) for kv in bench.split()[1:])
+    dis, func, path, cur, where = {}, {}, {}, '?', '?'
+    for line in subprocess.run([objdump, '-d', '-l', '--no-show-raw-insn', elf], capture_output=True, text=True).stdout.splitlines():
+        mm = re.match(r'^[0-9a-f]+ <(.*)>:', line)
+        if mm:
+            cur, where = mm.group(1), '?'
+            continue
+        mm = re.match(r'^; (/\S+?):(\d+)', line)
+        if mm:
+            where = mm.group(1)
+            continue
+        mm = re.match(r'\s*([0-9a-f]+):\s+(\S+)\s*(.*)', line)
+        if mm:
+            a = int(mm.group(1), 16)
+            dis[a], func[a], path[a] = (mm.group(2), mm.group(3).split('@')[0]), cur, where
+    cnt = {}
+    for line in open(counts):
+        a, c = line.split()
+        cnt[int(a, 16)] = int(c)
+    addrs = sorted(dis)
+    nxt = {a: b for a, b in zip(addrs, addrs[1:])}
+    skip_fn = re.compile(r'__stext|memset|memclr|memcpy|fmt|Formatter|heapless|semihosting|hprint|Reset|__pre_init')
+    ins = cyc = 0
+    for a, c in cnt.items():
+        if a not in dis or skip_fn.search(func[a]) or '/boards/' in path[a]:
+            continue
+        mn, ops = dis[a]
+        fall = cnt.get(nxt.get(a), 0)
+        taken = max(0.0, min(1.0, (c - fall) / c)) if c else 0.0
+        ins += c
+        cyc += c * cycles_of(mn, ops, taken)
+    cpi = cyc / ins
+    n = int(f['instructions'])
+    px, fr, tri = int(f['pixels']), int(f['fragments']), int(f['triangles'])
+    print(f"cycles board={board} scene={scene} instructions={n} instr_per_px={n / px:.1f} instr_per_fragment={n / fr:.1f} "
+          f"instr_per_tri={n / tri:.1f} cpi={cpi:.3f} est_cycles_per_px={n * cpi / px:.1f} "
+          f"est_cycles_per_fragment={n * cpi / fr:.1f} est_cycles_per_tri={n * cpi / tri:.1f}", flush=True)
