@@ -138,9 +138,62 @@ fn fresh<const UP: bool>(tau: u32) -> i32 {
 /// One Newton-Raphson step on `2^X / tau` from the seed `xs`.
 #[inline(always)]
 fn newton<const UP: bool>(tau: u32, xs: i32) -> i32 {
-    let p = ((tau as u64 * xs as u32 as u64) >> 32) as u32; // tau xs / 2^32, about 2^(X - 32)
+    let p = mul_hi(tau, xs as u32); // tau xs / 2^32, about 2^(X - 32)
     let e = (p << if UP { 4 } else { 3 }) as i32; // (tau xs / 2^X - 1) 2^32, small
-    xs.wrapping_sub(((xs as i64 * e as i64) >> 32) as i32)
+    xs.wrapping_sub(smul_hi(xs, e))
+}
+
+/// The high word of the 64-bit product (`UMULL` where the core has it).
+#[inline(always)]
+fn mul_hi(a: u32, b: u32) -> u32 {
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    return mul_hi_halves(a, b);
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    return ((a as u64 * b as u64) >> 32) as u32;
+}
+
+/// The high word of the signed 64-bit product (`SMMUL` where the core has it).
+#[inline(always)]
+fn smul_hi(a: i32, b: i32) -> i32 {
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    return smul_hi_halves(a, b);
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    return ((a as i64 * b as i64) >> 32) as i32;
+}
+
+/// The exact high word of `a b` from four 16 x 16 -> 32 products: ARMv6-M (Cortex-M0/M0+) has only `MULS`, which keeps
+/// the low 32 bits, and a 64-bit product is a library call there (about 45 instructions). With `a = ah 2^16 + al` and
+/// `b = bh 2^16 + bl`, the high word is `ah bh + (al bh >> 16) + (ah bl >> 16)` plus the carry out of the middle
+/// column, `((al bl >> 16) + (al bh & 0xffff) + (ah bl & 0xffff)) >> 16` (below `3 * 2^16`, no overflow): the same bits
+/// as the 64-bit product, so frames stay bit-identical across cores.
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn mul_hi_halves(a: u32, b: u32) -> u32 {
+    let (ah, al, bh, bl) = (a >> 16, a & 0xffff, b >> 16, b & 0xffff);
+    // LLVM recognises the whole sum as the high word of a 64-bit product and calls the library for it again; an
+    // opaque value (no instruction of its own) keeps the four products.
+    let (lh, hl) = (core::hint::black_box(al) * bh, ah * bl);
+    let mid = ((al * bl) >> 16) + (lh & 0xffff) + (hl & 0xffff);
+    (ah * bh) + (lh >> 16) + (hl >> 16) + (mid >> 16)
+}
+
+/// The signed high word from the unsigned one: `a b = ua ub - 2^32 (b [a < 0] + a [b < 0])` modulo `2^64`.
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn smul_hi_halves(a: i32, b: i32) -> i32 {
+    let h = mul_hi_halves(a as u32, b as u32) as i32;
+    let h = if a < 0 { h.wrapping_sub(b) } else { h };
+    if b < 0 {
+        h.wrapping_sub(a)
+    } else {
+        h
+    }
 }
 
 /// The first-order difference `x_(k+1) - x_k = -x r`, `r = delta / tau = delta x / 2^X`, to start the extrapolation.
@@ -455,6 +508,39 @@ mod tests {
     fn chained_and_fresh_spans_hold_the_bound() {
         for (pixels, chained) in [sweep::<true>(), sweep::<false>()] {
             assert!(chained > pixels / 4, "the sweep must exercise chaining");
+        }
+    }
+
+    /// The M0's high-word products equal the 64-bit ones (so every core computes the same frames).
+    #[test]
+    fn halves_products_equal_64_bit_products() {
+        let mut state = 0x1234_5678_9ABC_DEF1_u64;
+        let edges = [
+            0u32,
+            1,
+            0xffff,
+            0x1_0000,
+            0x7fff_ffff,
+            0x8000_0000,
+            u32::MAX,
+        ];
+        for k in 0..400_000 {
+            let (a, b) = if k < 49 {
+                (edges[k / 7], edges[k % 7])
+            } else {
+                (rnd(&mut state) as u32, (rnd(&mut state) >> 32) as u32)
+            };
+            assert_eq!(
+                mul_hi_halves(a, b),
+                ((a as u64 * b as u64) >> 32) as u32,
+                "{a} {b}"
+            );
+            let (sa, sb) = (a as i32, b as i32);
+            assert_eq!(
+                smul_hi_halves(sa, sb),
+                ((sa as i64 * sb as i64) >> 32) as i32,
+                "{sa} {sb}"
+            );
         }
     }
 
