@@ -6,7 +6,7 @@
 //! part in front of the near plane instead of wrapping around through infinity (the "flashing" triangles of naive
 //! rasterizers). x and y are clipped to the guard band (4000 px, inside the rasterizer's 4096), so any triangle in
 //! front of the eye draws. The far plane needs no clip: pixels beyond `W_far` fail the depth range per pixel.
-//! The projection must give `w` = eye depth (seed 002's W-friendly matrix; [`crate::projection::is_w_friendly`]).
+//! The projection must give `w` = eye depth (Dunlop's "Using W-Buffers" W-friendly matrix; [`crate::projection::is_w_friendly`]).
 
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::PixelColor;

@@ -1,5 +1,5 @@
 //! The packed 16-bit W-buffer: `round(W / W_far * 65535)`, the "16-bit fixed, scale 1.0" row of the format table in
-//! seed 000_92e7aa22df8423f2.txt (`W_scaled = W / W_far * scale_factor`).
+//! Rogers, "W-Buffering in Direct3D" (NVIDIA) (`W_scaled = W / W_far * scale_factor`).
 
 use crate::Error;
 

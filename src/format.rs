@@ -2,10 +2,10 @@
 //! ones it names. These are the formats' definitions (encode with round to nearest, decode, the step between
 //! neighbouring codes, packed storage), in f64: the reference every renderer and the precision tool measure against.
 //!
-//! Sources: seed 000_92e7aa22df8423f2.txt (the table: 16-bit float W with scale 2^8, 16-bit fixed W with scale 1.0,
+//! Sources: Rogers, "W-Buffering in Direct3D" (NVIDIA) (the table: 16-bit float W with scale 2^8, 16-bit fixed W with scale 1.0,
 //! 24-bit float W stored directly or scaled by 2^127 / W_far: `W_scaled = W / W_far * scale_factor`), seed
-//! 003_0afae2e2ce9f2c57.txt (24-bit: IEEE single without the low mantissa byte; 32-bit IEEE), seed
-//! 004_7efaf595ce119344.txt (linear Z, `z * w / far`), and Direct3D's `[0, 1]` Z, `Z = f / (f - n) * (1 - n / d)`.
+//! Microsoft, "W-Buffering" (Direct3D DDK) (24-bit: IEEE single without the low mantissa byte; 32-bit IEEE), seed
+//! Dunlop, "Linear Depth" (linear Z, `z * w / far`), and Direct3D's `[0, 1]` Z, `Z = f / (f - n) * (1 - n / d)`.
 //! `n`, `f` are `W_near`, `W_far`; `d` is eye depth. Depths outside `[n, f]` saturate to the end codes.
 
 /// A depth storage format.
@@ -101,7 +101,7 @@ macro_rules! unorm_format {
 }
 
 unorm_format!(
-    /// Linear W, 16-bit unorm: `round(W / W_far * 65535)` (seed 000: "16-bit fixed, scale 1.0"). The core's format.
+    /// Linear W, 16-bit unorm: `round(W / W_far * 65535)` (Rogers: "16-bit fixed, scale 1.0"). The core's format.
     W16, "W16", 2, 0xffff, |d, _n, f| d / f, |v, _n, f| v * f
 );
 unorm_format!(
@@ -113,11 +113,11 @@ unorm_format!(
     Z24, "Z24", 3, 0xff_ffff, z_of, d_of_z
 );
 unorm_format!(
-    /// Linear Z in a 16-bit Z buffer: the value of seed 004's `z * w / far` trick at a vertex, `(d - n) / (f - n)`.
+    /// Linear Z in a 16-bit Z buffer: the value of Dunlop's "Linear Depth" `z * w / far` trick at a vertex, `(d - n) / (f - n)`.
     LZ16, "LZ16", 2, 0xffff, |d, n, f| (d - n) / (f - n), |v, n, f| n + v * (f - n)
 );
 
-/// The 16-bit float W of seed 000's table ("16-bit floating point, scale 2^8"): unsigned E4M12 (4-bit exponent,
+/// The 16-bit float W of Rogers's table ("16-bit floating point, scale 2^8"): unsigned E4M12 (4-bit exponent,
 /// bias 7, 12-bit mantissa, implicit one; largest value 511.9375), storing `W / W_far * 2^8`. Values below the
 /// smallest normal, `2^-6`, are denormals (`m / 4096 * 2^-6`): with `f / n <= 2^14` every depth is normal.
 pub struct W16F;
@@ -164,7 +164,7 @@ impl DepthFormat for W16F {
     }
 }
 
-/// f32 bits of a positive value with the low mantissa byte rounded off (seed 003's 24-bit float).
+/// f32 bits of a positive value with the low mantissa byte rounded off (the DDK's "W-Buffering" 24-bit float).
 fn f24_of(v: f64) -> u32 {
     ((v as f32).to_bits() + 0x80) >> 8
 }
@@ -173,8 +173,8 @@ fn f24_value(code: u32) -> f64 {
     f32::from_bits(code << 8) as f64
 }
 
-/// The 24-bit float W (seed 003: an IEEE single without its low mantissa byte, 3 bytes), W stored directly
-/// (seed 000's first option: "load the W value in directly", losing the low mantissa bits).
+/// The 24-bit float W (the DDK's "W-Buffering": an IEEE single without its low mantissa byte, 3 bytes), W stored directly
+/// (Rogers's first option: "load the W value in directly", losing the low mantissa bits).
 pub struct W24F;
 
 impl DepthFormat for W24F {
@@ -192,7 +192,7 @@ impl DepthFormat for W24F {
     }
 }
 
-/// The 24-bit float W scaled by `2^127 / W_far` (seed 000's second option), so the far plane is `2^127`.
+/// The 24-bit float W scaled by `2^127 / W_far` (Rogers's second option), so the far plane is `2^127`.
 pub struct W24FScaled;
 
 impl DepthFormat for W24FScaled {
@@ -210,7 +210,7 @@ impl DepthFormat for W24FScaled {
     }
 }
 
-/// IEEE single W (seed 003's 32-bit format), 4 bytes.
+/// IEEE single W (the DDK's "W-Buffering" 32-bit format), 4 bytes.
 pub struct W32F;
 
 impl DepthFormat for W32F {
@@ -331,7 +331,7 @@ mod tests {
         round_trip::<LZ16>();
     }
 
-    /// W16's step is `W_far / 65535` everywhere (precision.md: unorm W, constant step).
+    /// W16's step is `W_far / 65535` everywhere (the precision notes in ARCHITECTURE.md: unorm W, constant step).
     #[test]
     fn w16_step_is_constant() {
         for (n, f) in RANGES {
@@ -342,7 +342,7 @@ mod tests {
         }
     }
 
-    /// E4M12 as seed 000 / precision.md define it: the far plane is 256 (code 0xF000), the largest value 511.9375,
+    /// E4M12 as Rogers defines it: the far plane is 256 (code 0xF000), the largest value 511.9375,
     /// the smallest normal 2^-6 (code 0x1000), and every depth is normal exactly while f / n <= 2^14.
     #[test]
     fn w16f_layout() {
@@ -362,7 +362,7 @@ mod tests {
     }
 
     /// Float formats with m stored mantissa bits resolve between `d 2^-(m+1)` and `d 2^-m` while normal
-    /// (precision.md: float W, constant relative step): m = 12 (W16F), 15 (24-bit), 23 (32-bit).
+    /// (the precision notes in ARCHITECTURE.md: float W, constant relative step): m = 12 (W16F), 15 (24-bit), 23 (32-bit).
     #[test]
     fn float_w_relative_steps() {
         fn check<F: DepthFormat>(m: i32) {

@@ -5,6 +5,11 @@
 //! (`round(W / W_far * 65535)`), whose precision is spread evenly over the depth range. Pixel centres are at
 //! `(i + 0.5, j + 0.5)`, as in Direct3D 10 and later and OpenGL.
 //!
+//! Strategies are type parameters. The default, [`recip::Fast`] (the fast tier), walks W16 spans in 32-bit arithmetic
+//! with a reciprocal carried along the span and the depth test ahead of it: every stored code within 1 LSB of the
+//! correctly rounded one, at least 99.9% exact (derived in the crate's `fast` module). [`recip::Exact`] (the exact tier)
+//! solves each triangle's depth plane exactly and takes a 28-bit reciprocal at every pixel.
+//!
 //! ```
 //! use embedded_graphics_core::pixelcolor::Rgb565;
 //! use embedded_graphics_core::prelude::*;

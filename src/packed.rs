@@ -6,7 +6,7 @@
 //!   or [`crate::recip::Quake`]);
 //! - Z formats ([`Input::Z`]) take D3D's `[0, 1]` Z, which is affine in `1/W` and so needs no reciprocal:
 //!   `Z = 1 - rz`, `rz = (t - 1) n / (f - n)` (the reversed Z), in Q0.60, from `T` with one multiply;
-//! - the linear-Z trick ([`Input::LinearZ`], seed 004_7efaf595ce119344.txt's `z * w / far`) computes each vertex's
+//! - the linear-Z trick ([`Input::LinearZ`], Dunlop's "Linear Depth" `z * w / far`) computes each vertex's
 //!   `(W - n) / (f - n)` exactly and interpolates it linearly in screen space, as the hardware interpolates any
 //!   vertex z: right at the vertices, wrong inside (the error the seed does not mention, shown by the tests).
 //!
@@ -333,7 +333,7 @@ impl<'a, F: Codec> Packed<'a, F> {
     }
 }
 
-/// The depth buffering a draw gets after seed 002's capability check (see [`DepthMode`]).
+/// The depth buffering a draw gets after Dunlop's "Using W-Buffers" capability check (see [`DepthMode`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Resolved {
     /// What the draw does.
@@ -378,7 +378,7 @@ impl<R: WSpan> Rasterizer<R> {
     }
 
     /// Draws one flat-coloured triangle into `target` and a depth buffer of any format (or none: depth off; the rows
-    /// and columns are then the target's). The depth test runs before any colour work for the pixel (seed 001): a
+    /// and columns are then the target's). The depth test runs before any colour work for the pixel (the Windows CE "Depth Buffering" docs): a
     /// passing pixel's colour is sent with its run. On an error nothing is written.
     pub fn draw_format<F: Codec, D>(
         &mut self,
@@ -473,7 +473,7 @@ impl<R: WSpan> Rasterizer<R> {
         Ok(stats)
     }
 
-    /// The triangle's depth bias in `F`'s codes (feature `bias`): seed 001's offset with `m` from the plane of the
+    /// The triangle's depth bias in `F`'s codes (feature `bias`): the Windows CE "Depth Buffering" docs' offset with `m` from the plane of the
     /// vertices' codes (see [`crate::RenderState::depth_bias`]).
     #[cfg(feature = "bias")]
     fn format_bias<F: Codec>(
@@ -515,9 +515,9 @@ impl<R: WSpan> Rasterizer<R> {
     }
 }
 
-/// Points, lines and wireframe triangles (seed 001's primitives), through the same `T` (RHW) path, the same
+/// Points, lines and wireframe triangles (the Windows CE "Depth Buffering" docs' primitives), through the same `T` (RHW) path, the same
 /// W strategy and the same depth test as solid triangles. Depth bias applies to wireframe triangles, never to points
-/// or lines (seed 001).
+/// or lines (the Windows CE "Depth Buffering" docs).
 ///
 /// Rules. A point covers the pixel that contains it, `(floor x, floor y)`, at its own depth. A line covers, for each
 /// column (x-major, `|dx| >= |dy|`) or row (y-major) whose pixel centre lies in `[start, end)` of the snapped

@@ -1,4 +1,4 @@
-//! Projection matrices and the W planes, as in seed 000_92e7aa22df8423f2.txt ("W-Buffering in Direct3D").
+//! Projection matrices and the W planes, as in Rogers, "W-Buffering in Direct3D" (NVIDIA) ("W-Buffering in Direct3D").
 //! Matrices are row-major and apply to row vectors, `v' = v * M`, as in the seeds: `m[r][c]` is Direct3D's
 //! `_rc` with both indices from 0, so `_34` is `m[2][3]`.
 
@@ -54,11 +54,11 @@ fn sin_cos(x: f64) -> (f64, f64) {
     (s, c)
 }
 
-/// `D3DUtil_SetProjectionMatrix` (seed 000): `_11 = cos(fov/2) * aspect`, `_22 = cos(fov/2)`,
+/// `D3DUtil_SetProjectionMatrix` (Rogers): `_11 = cos(fov/2) * aspect`, `_22 = cos(fov/2)`,
 /// `_33 = Q = far sin(fov/2) / (far - near)`, `_34 = sin(fov/2)`, `_43 = -Q near`. Its `E_INVALIDARG` when
 /// `far - near < 0.01` is [`Error::InvalidDepthRange`]; a field of view outside `(0, pi)` or a non-finite input is
 /// [`Error::NonFinite`]. (This matrix has `W = z sin(fov/2)`: its W planes are `near sin`, `far sin`, and it is not
-/// W-friendly in seed 002's sense.)
+/// W-friendly in Dunlop's "Using W-Buffers" sense.)
 pub fn perspective(fov: f32, aspect: f32, near: f32, far: f32) -> Result<Mat4, Error> {
     if !(fov.is_finite() && aspect.is_finite() && near.is_finite() && far.is_finite()) {
         return Err(Error::NonFinite);
@@ -81,7 +81,7 @@ pub fn perspective(fov: f32, aspect: f32, near: f32, far: f32) -> Result<Mat4, E
     Ok(Mat4(m))
 }
 
-/// `W_near` and `W_far` of a projection matrix by seed 000's formulas:
+/// `W_near` and `W_far` of a projection matrix by Rogers's formulas:
 /// `dvWNear = _44 - _43 / _33 * _34`, `dvWFar = (_44 - _43) / (_33 - _34) * _34 + _44`.
 /// A matrix for which they are not finite, or do not give `0 < W_near < W_far`, is an error.
 pub fn w_planes(m: &Mat4) -> Result<(f32, f32), Error> {
@@ -103,7 +103,7 @@ pub fn w_planes(m: &Mat4) -> Result<(f32, f32), Error> {
     Ok((near, far))
 }
 
-/// The matrix seed 000's `set_wbuffer_planes` builds (identity but `_33 = W_near / (W_far - W_near) + 1`,
+/// The matrix Rogers's `set_wbuffer_planes` builds (identity but `_33 = W_near / (W_far - W_near) + 1`,
 /// `_34 = 1`, `_43 = 0`, `_44 = W_near`), whose W planes are `(W_near, W_far)`. Its error when `W_far <= W_near`
 /// (the seed returns 1), and, since W-buffering needs it, when `W_near <= 0`.
 pub fn wbuffer_planes_matrix(w_near: f32, w_far: f32) -> Result<Mat4, Error> {
@@ -121,7 +121,7 @@ pub fn wbuffer_planes_matrix(w_near: f32, w_far: f32) -> Result<Mat4, Error> {
     Ok(m)
 }
 
-/// Seed 002_84ba942b86c67763.txt's W-friendly test: the fourth column is `[0, 0, 1, 0]`, so the output W equals the
+/// Seed Dunlop's "Using W-Buffers" W-friendly test: the fourth column is `[0, 0, 1, 0]`, so the output W equals the
 /// input z (eye depth). Other matrices give a W that is only proportional to depth (or not at all).
 pub fn is_w_friendly(m: &Mat4) -> bool {
     m.at(1, 4) == 0.0 && m.at(2, 4) == 0.0 && m.at(3, 4) == 1.0 && m.at(4, 4) == 0.0
@@ -135,7 +135,7 @@ mod tests {
         (a - b).abs() <= ulps * f32::EPSILON * b.abs().max(1e-30)
     }
 
-    /// `set_wbuffer_planes` then seed 000's formulas give the planes back: `_44 - 0 = W_near` exactly, and
+    /// `set_wbuffer_planes` then Rogers's formulas give the planes back: `_44 - 0 = W_near` exactly, and
     /// `W_near / (_33 - 1) + W_near = W_far` with `_33` rounded to f32 once and a few f64 operations: within a few
     /// f32 ulps scaled by `W_far / W_near` (the relative error of `_33 - 1` grows with it).
     #[test]
@@ -151,7 +151,7 @@ mod tests {
             let m = wbuffer_planes_matrix(n, f).unwrap();
             assert!(
                 !is_w_friendly(&m),
-                "seed 000's matrix keeps _44 = W_near: not [0,0,1,0]"
+                "Rogers's matrix keeps _44 = W_near: not [0,0,1,0]"
             );
             let (wn, wf) = w_planes(&m).unwrap();
             assert_eq!(wn, n);

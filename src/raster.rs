@@ -1,8 +1,8 @@
 //! Triangle setup and the span loop.
 //!
-//! Depth. Each vertex gives `t = W_far * rhw = W_far / W` (seed 000_92e7aa22df8423f2.txt: `W_TNT = RHW * dvRW_far`,
+//! Depth. Each vertex gives `t = W_far * rhw = W_far / W` (Rogers, "W-Buffering in Direct3D" (NVIDIA): `W_TNT = RHW * dvRW_far`,
 //! with the 16-bit fixed scale 1.0), so `W / W_far = 1/t`, the far plane is `t = 1` and the near plane `t = W_far/W_near`.
-//! `t` is linear in screen space (seed 003_0afae2e2ce9f2c57.txt: interpolate 1/w linearly, take the reciprocal per
+//! `t` is linear in screen space (Microsoft, "W-Buffering" (Direct3D DDK): interpolate 1/w linearly, take the reciprocal per
 //! pixel). It is held as `T = t * 2^F` in an `i64`, with `F = 61 - bits(floor(t_max))` fraction bits chosen per
 //! triangle from its largest vertex `t` (so `T < 2^61`; `F >= 30` since `t <= 2^30`; `F >= 47` when `t_max < 2^14`).
 //! The plane is solved exactly in `i128` at setup: the per-pixel steps and the value at a reference pixel are each
@@ -599,7 +599,7 @@ fn biased(code: u16, bias: i32) -> u16 {
     }
 }
 
-/// Seed 001_4caa61ee3442653f.txt's depth bias, `Offset = m * SLOPESCALEDEPTHBIAS + DEPTHBIAS`, in W16 codes.
+/// Seed the Windows CE "Depth Buffering" docs' depth bias, `Offset = m * SLOPESCALEDEPTHBIAS + DEPTHBIAS`, in W16 codes.
 /// W is not planar in screen space, so `m` is defined for a triangle as the larger of `|d code / dx|` and
 /// `|d code / dy|` (codes per pixel) of the plane through its three vertices' exact codes `65535 W_i / W_far`: the
 /// slope the triangle's depth has at its vertices' scale, which is what two coplanar triangles' rounding disagrees by.
@@ -665,18 +665,7 @@ impl<D: DrawTarget> Runs<'_, D> {
     /// Pixel `k` failed: flush the run before it.
     #[inline(always)]
     pub(crate) fn fail(&mut self, k: usize) -> Result<(), Error> {
-        self.fails += 1;
-        let start = core::mem::replace(&mut self.start, k + 1);
-        if start < k {
-            fill(
-                self.target,
-                self.lo + start as i32,
-                self.lo + k as i32,
-                self.j,
-                self.color,
-            )?;
-        }
-        Ok(())
+        self.fail_many(k, k + 1)
     }
     /// Pixels `a..b` fail (none when `a == b`): flush the run before `a`.
     #[inline(always)]

@@ -1,4 +1,4 @@
-//! Newton-Raphson reciprocals in fixed point: the per-pixel `W = 1/RHW` of seed 003_0afae2e2ce9f2c57.txt
+//! Newton-Raphson reciprocals in fixed point: the per-pixel `W = 1/RHW` of Microsoft, "W-Buffering" (Direct3D DDK)
 //! ("linearly interpolating the vertex 1/w term ..., computing its reciprocal per pixel").
 //!
 //! Formats. The input is a normalised mantissa `m` in `[2^31, 2^32)`, standing for `d = m / 2^32` in `[0.5, 1)`.
@@ -591,7 +591,7 @@ mod tests {
             R::NAME,
             R::MAX_REL_ERROR
         );
-        // The bound must also be meaningful: the precision note's bit counts (shared/notes/precision.md).
+        // The bound must also be meaningful: the bit counts of the precision notes (ARCHITECTURE.md).
         assert!(
             -R::MAX_REL_ERROR.log2() >= bits_at_least,
             "{}: bound {:e}",
@@ -608,7 +608,7 @@ mod tests {
 
     #[test]
     fn linear_seed_and_steps() {
-        // precision.md: 4.1, 8.2, 16.3 bits after 0, 1, 2 steps; the fixed-point floor (2^-29) caps step 3.
+        // The precision notes (ARCHITECTURE.md): 4.1, 8.2, 16.3 bits after 0, 1, 2 steps; the fixed-point floor (2^-29) caps step 3.
         assert_bound::<Newton<Linear, 0>>(4.0);
         assert_bound::<Newton<Linear, 1>>(8.0);
         assert_bound::<Newton<Linear, 2>>(16.0);
@@ -617,7 +617,7 @@ mod tests {
 
     #[test]
     fn table64_seed_and_steps() {
-        // precision.md: 7.0, 14.0, 28.0 bits; with the 2^-29 floor of the truncating products 2 steps give 27.45.
+        // The precision notes (ARCHITECTURE.md): 7.0, 14.0, 28.0 bits; with the 2^-29 floor of the truncating products 2 steps give 27.45.
         assert_bound::<Newton<Table64, 0>>(6.9);
         assert_bound::<Newton<Table64, 1>>(13.8);
         assert_bound::<Newton<Table64, 2>>(27.4);

@@ -1,6 +1,6 @@
 //! The standard scenes, defined once for the host tests, the benches and the boards (feature `scenes`).
 //!
-//! `big`, `overdraw` and `small` are W1, W2 and W3 of the benchmark workloads (shared/scenes/workloads.md), exactly:
+//! `big`, `overdraw` and `small` are W1, W2 and W3 of the project's benchmark workloads (described in the README), exactly:
 //! 320 x 240, flat colour per triangle, drawn in the order listed, depth cleared, `Less`. Their vertices are given on
 //! pixel centres; wraster's centres are at `i + 0.5`, so `(x, y)` of the workloads becomes `(x + 0.5, y + 0.5)`.
 //! `terrain` is the demo scene: a ground grid receding from `W_near = 10` to `W_far = 10000` with interpenetrating

@@ -8,7 +8,7 @@ use crate::Error;
 pub const MAX_T: f32 = (1u32 << 30) as f32;
 pub(crate) const MAX_T_LOG2: i32 = 30;
 
-/// The depth comparison `new CMP stored` of seed 001_4caa61ee3442653f.txt (D3DMCMPFUNC). For the W-buffer, smaller is
+/// The depth comparison `new CMP stored` of Microsoft, "Depth Buffering (Windows CE 5.0)" (D3DMCMPFUNC). For the W-buffer, smaller is
 /// nearer, so `Less` keeps the nearest surface.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Compare {
@@ -47,11 +47,11 @@ impl Compare {
     }
 }
 
-/// What the depth buffer holds, like seed 001_4caa61ee3442653f.txt's `D3DMRS_ZENABLE` (FALSE / TRUE / USEW).
+/// What the depth buffer holds, like the Windows CE "Depth Buffering" docs' `D3DMRS_ZENABLE` (FALSE / TRUE / USEW).
 /// The format decides what it can store: W formats hold W, Z formats Z. Asking for W with a Z format falls back to Z
-/// (seed 002_84ba942b86c67763.txt's capability check: `USEW` if the device can, else `TRUE`), and the draw says so
+/// (Dunlop's "Using W-Buffers" capability check: `USEW` if the device can, else `TRUE`), and the draw says so
 /// ([`crate::Resolved`]); asking for Z with a W format is an error. Without a depth buffer depth is off, whatever is
-/// asked (seed 001: depth buffering needs a depth buffer).
+/// asked (the Windows CE "Depth Buffering" docs: depth buffering needs a depth buffer).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DepthMode {
     /// No depth test, no depth write (`D3DZB_FALSE`).
@@ -74,7 +74,7 @@ pub enum Cull {
 }
 
 /// The eye-space depth range `[W_near, W_far]`, checked: `0 < W_near < W_far`, both finite, ratio at most [`MAX_T`].
-/// Seed 000_92e7aa22df8423f2.txt: "W_near must be greater than zero. W_far must be greater than W_near."
+/// Seed Rogers, "W-Buffering in Direct3D" (NVIDIA): "W_near must be greater than zero. W_far must be greater than W_near."
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DepthRange {
     near: f32,
@@ -147,10 +147,10 @@ pub struct RenderState {
     pub depth_write: bool,
     /// Face culling.
     pub cull: Cull,
-    /// Constant depth bias, in W16 codes (feature `bias`; seed 001's DEPTHBIAS). Negative pulls towards the eye.
+    /// Constant depth bias, in W16 codes (feature `bias`; the Windows CE "Depth Buffering" docs' DEPTHBIAS). Negative pulls towards the eye.
     #[cfg(feature = "bias")]
     pub depth_bias: f32,
-    /// Slope-scaled depth bias (feature `bias`; seed 001's SLOPESCALEDEPTHBIAS), times the triangle's `m`.
+    /// Slope-scaled depth bias (feature `bias`; the Windows CE "Depth Buffering" docs' SLOPESCALEDEPTHBIAS), times the triangle's `m`.
     #[cfg(feature = "bias")]
     pub slope_scale_depth_bias: f32,
 }

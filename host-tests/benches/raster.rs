@@ -1,11 +1,11 @@
-//! Host time of the standard scenes (W1-W3 of shared/scenes/workloads.md and the terrain demo): a depth clear and
+//! Host time of the standard scenes (W1-W3 of the README's standard scenes and the terrain demo): a depth clear and
 //! the draw calls, into a host framebuffer that checks every write. Throughput is per written pixel for
 //! big/overdraw/terrain and per triangle for small.
 //! `cargo bench -p host-tests --bench raster`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use host_tests::Frame;
-use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, SpanRecip};
+use wraster::recip::{Exact, Fast, PrevPixel, SpanRecip};
 use wraster::scenes::{Scene, HEIGHT, WIDTH};
 use wraster::{DepthStore, Rasterizer, RenderState};
 
@@ -30,7 +30,7 @@ fn scenes(c: &mut Criterion) {
     let mut depth = Box::new(DepthStore::<320, 240>::new());
     let mut g = c.benchmark_group("scene");
     for scene in Scene::ALL {
-        let written = draw_scene::<PerPixel<DefaultRecip>>(scene, &mut frame, &mut depth);
+        let written = draw_scene::<Fast>(scene, &mut frame, &mut depth);
         println!(
             "scene={} triangles={} written={written}",
             scene.name(),
@@ -41,11 +41,12 @@ fn scenes(c: &mut Criterion) {
         } else {
             written as u64
         }));
-        g.bench_with_input(
-            BenchmarkId::new("default", scene.name()),
-            &scene,
-            |b, &s| b.iter(|| draw_scene::<PerPixel<DefaultRecip>>(s, &mut frame, &mut depth)),
-        );
+        g.bench_with_input(BenchmarkId::new("fast", scene.name()), &scene, |b, &s| {
+            b.iter(|| draw_scene::<Fast>(s, &mut frame, &mut depth))
+        });
+        g.bench_with_input(BenchmarkId::new("exact", scene.name()), &scene, |b, &s| {
+            b.iter(|| draw_scene::<Exact>(s, &mut frame, &mut depth))
+        });
         g.bench_with_input(
             BenchmarkId::new("prev-pixel", scene.name()),
             &scene,

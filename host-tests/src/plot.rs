@@ -9,7 +9,7 @@ use embedded_graphics::text::Text;
 use embedded_graphics_simulator::{OutputSettingsBuilder, SimulatorDisplay};
 use wraster::format::*;
 
-/// One format's measurement and its analytic step (precision.md).
+/// One format's measurement and its analytic step (the precision notes in ARCHITECTURE.md).
 pub struct Row {
     /// Format name.
     pub name: &'static str,
@@ -17,7 +17,7 @@ pub struct Row {
     pub stored: fn(f64, f64, f64) -> f64,
     /// The measured step at `d`.
     pub step: fn(f64, f64, f64) -> f64,
-    /// precision.md's analytic step at `d`.
+    /// the analytic step (ARCHITECTURE.md) at `d`.
     pub analytic: fn(f64, f64, f64) -> f64,
     /// Plot colour.
     pub color: Rgb888,
@@ -37,7 +37,7 @@ fn p2(e: i32) -> f64 {
     2f64.powi(e)
 }
 
-/// The formats and precision.md's analytic steps: unorm Z `2^-k d^2 (f-n)/(f n)`, unorm W `2^-k f`,
+/// The formats and the analytic steps of ARCHITECTURE.md's precision notes: unorm Z `2^-k d^2 (f-n)/(f n)`, unorm W `2^-k f`,
 /// float W with m mantissa bits `d 2^-m` (upper bound), float Z `2^-23 z d^2 (f-n)/(f n)`.
 pub fn rows() -> Vec<Row> {
     vec![

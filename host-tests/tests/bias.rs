@@ -1,4 +1,4 @@
-//! Depth bias (seed 001_4caa61ee3442653f.txt: `Offset = m * SLOPESCALEDEPTHBIAS + DEPTHBIAS`), in W16 codes.
+//! Depth bias (Microsoft, "Depth Buffering (Windows CE 5.0)": `Offset = m * SLOPESCALEDEPTHBIAS + DEPTHBIAS`), in W16 codes.
 //!
 //! Two triangles in one plane (1/W affine in screen space, both evaluated from the same plane) fight: each stored
 //! code is within 1 LSB of its exact value (the core's depth bound), and the two exact values differ only by the

@@ -1,4 +1,4 @@
-//! The eight comparison functions of seed 001_4caa61ee3442653f.txt (D3DMCMPFUNC), with depth write on and off, in
+//! The eight comparison functions of Microsoft, "Depth Buffering (Windows CE 5.0)" (D3DMCMPFUNC), with depth write on and off, in
 //! rendering: a second triangle drawn over a first passes exactly where the function holds between its own code and
 //! the stored one, and only then writes colour (and depth, if writing); the test runs before any colour work.
 //! The expected results come from this file's own reading of the comparison, applied to the codes each triangle

@@ -1,5 +1,5 @@
 //! Rendering into every depth format (src/packed.rs) against the f64 reference and the formats' definitions;
-//! depth modes and seed 002's capability check; the linear-Z trick inside triangles.
+//! depth modes and Dunlop's "Using W-Buffers" capability check; the linear-Z trick inside triangles.
 
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::pixelcolor::RgbColor;
@@ -56,7 +56,7 @@ fn packed_w16_equals_the_lean_path() {
 fn value_bound<F: Codec>(v: f64) -> f64 {
     let t_err = 2f64.powi(-31);
     match F::INPUT {
-        // The 24-bit float formats are defined (seed 003) as the f32 with its low byte rounded off: a double rounding,
+        // The 24-bit float formats are defined (the DDK's "W-Buffering") as the f32 with its low byte rounded off: a double rounding,
         // which adds up to half an f32 step, 2^-24 relative.
         Input::W if F::BYTES == 3 => {
             v * (PerPixel::<DefaultRecip>::MAX_REL_ERROR + 2f64.powi(-31) + t_err + 2f64.powi(-24))
@@ -237,7 +237,7 @@ fn linear_z_trick_errs_inside_triangles_within_kantorovich() {
     assert!(max_rel > 0.25 && max_codes > 100);
 }
 
-/// Seed 002's capability check and seed 001's "no depth buffer, no depth".
+/// Seed 002's capability check and the Windows CE "Depth Buffering" docs' "no depth buffer, no depth".
 #[test]
 fn modes_fall_back_and_depth_is_off_without_a_buffer() {
     use DepthMode::{Off, Z};
@@ -370,7 +370,7 @@ fn packed_buffers_check_their_size() {
     assert_eq!(buf.get(2, 1), None);
 }
 
-/// Depth bias in the packed path, in each format's codes (seed 001, "in the units of the buffer in use"), for two
+/// Depth bias in the packed path, in each format's codes (the Windows CE "Depth Buffering" docs, "in the units of the buffer in use"), for two
 /// triangles in one plane (B inside A, drawn after it with `Less`; the geometry of bias.rs, depths 51 to 238, range
 /// 1..1000). Their stored codes disagree by at most `k` codes, so without bias B fights and with a bias of `-(k + 1)`
 /// it shows everywhere:

@@ -50,7 +50,7 @@ fn visible(state: RenderState) -> (usize, usize) {
 /// triangle's plane errs by at most `|grad t| sqrt(2) / 512` at its vertices and so everywhere inside; two triangles
 /// disagree by twice that, in codes `2 sqrt(2) / 512 |grad code| <= (4 / 512) g` with `g` the larger axis slope of the
 /// code at the pixel. The code `65535 / t` is not planar: along a segment from `t0` to `t1` its local slope is at most
-/// `t_max / t_min = r` times its secant slope, and seed 001's `m` (the bias's slope) is that secant slope of B's vertex
+/// `t_max / t_min = r` times its secant slope, and the Windows CE "Depth Buffering" docs' `m` (the bias's slope) is that secant slope of B's vertex
 /// codes, so `g <= r m`. With the 3 codes of rounding (bias.rs), an offset of `-(3 + r m / 128)` codes is enough:
 /// `depth_bias = -4` and `slope_scale_depth_bias = -r / 128`. Without bias the pair fights.
 #[test]

@@ -1,7 +1,7 @@
-//! The seeds' quantitative claims about Z and W depth, recomputed in f64 from the projection's definitions
+//! The source documents' quantitative claims about Z and W depth, recomputed in f64 from the projection's definitions
 //! (part of the depth issue). The Z mapping is Direct3D's `[0, 1]` one, `Z(d) = f / (f - n) * (1 - n / d)` for eye
-//! depth `d` (seed 000's `D3DUtil_SetProjectionMatrix`: `Q = f / (f - n)`, `z' = Q d - Q n`, `Z = z' / d`).
-//! Tolerances are the seeds' printed precision (six decimals: half a unit in the last place) plus f64 rounding.
+//! depth `d` (Rogers's `D3DUtil_SetProjectionMatrix`: `Q = f / (f - n)`, `z' = Q d - Q n`, `Z = z' / d`).
+//! Tolerances are the documents' printed precision (six decimals: half a unit in the last place) plus f64 rounding.
 
 fn z(n: f64, f: f64, d: f64) -> f64 {
     f / (f - n) * (1.0 - n / d)
@@ -10,7 +10,7 @@ fn z(n: f64, f: f64, d: f64) -> f64 {
 /// Half a unit in the sixth decimal: the seed's tables print six.
 const SIX_DECIMALS: f64 = 0.5e-6 + 1e-12;
 
-/// 004_7efaf595ce119344.txt, near 10 / far 10000: Z at 100, 500, 1000 and far; and the linear-Z trick
+/// Dunlop, "Linear Depth", near 10 / far 10000: Z at 100, 500, 1000 and far; and the linear-Z trick
 /// (`vPos.z = vPos.z * vPos.w / Far`), whose output is `Z * d / f = (d - n) / (f - n)`, at 100, 500, 1000, 5000 and far.
 #[test]
 fn seed_004_tables() {
@@ -47,7 +47,7 @@ fn seed_004_tables() {
     }
 }
 
-/// 002_84ba942b86c67763.txt, near 10 / far 1000: "half of the number space is used in the first 10 units of
+/// Dunlop, "Using W-Buffers", near 10 / far 1000: "half of the number space is used in the first 10 units of
 /// distance after the near plane" and "at a distance of 100, over 90% of the range ... has been used".
 #[test]
 fn seed_002_claims() {
@@ -66,7 +66,7 @@ fn seed_002_claims() {
     );
 }
 
-/// 003_0afae2e2ce9f2c57.txt: far/near 100 uses "90 percent of the depth buffer range on the first 10 percent of the
+/// Microsoft, "W-Buffering" (Direct3D DDK): far/near 100 uses "90 percent of the depth buffer range on the first 10 percent of the
 /// scene depth range" (true: exactly 91.7%), and at 1000 "98 percent of the range is used on the first two percent
 /// of the depth". The second is wrong by exact arithmetic: the first 2% of `[n, f]` holds 95.3% of the range.
 #[test]
@@ -84,11 +84,11 @@ fn seed_003_claims_and_its_error() {
     );
 }
 
-/// 004_7efaf595ce119344.txt's trick stores `(d - n) / (f - n)` at the vertices, and the rasterizer interpolates it
+/// Dunlop's "Linear Depth" trick stores `(d - n) / (f - n)` at the vertices, and the rasterizer interpolates it
 /// linearly in screen space, while depth itself is perspective-correct (1/d is what is linear in screen space).
 /// Along an edge from `d0` to `d1 = r d0`, at screen fraction `s` the trick gives `(1 - s) d0 + s d1` against the
 /// true `1 / ((1 - s)/d0 + s/d1)`: relative error `s (1 - s) (r - 1)^2 / r`, largest at the middle, `(r - 1)^2 / (4r)`
-/// (precision.md: 12.5% at r = 2, 56% at r = 4, 203% at r = 10). The seeds' table is exact only at vertices.
+/// (ARCHITECTURE.md, precision notes: 12.5% at r = 2, 56% at r = 4, 203% at r = 10). The documents' table is exact only at vertices.
 #[test]
 fn linear_z_trick_interior_error() {
     let (n, f) = (10.0, 10000.0);
@@ -109,7 +109,7 @@ fn linear_z_trick_interior_error() {
         assert!((worst - bound).abs() < 1e-12, "r = {r}: {worst} vs {bound}");
         assert!(
             (bound - printed).abs() < 1e-3,
-            "precision.md prints {printed} for r = {r}"
+            "the precision notes print {printed} for r = {r}"
         );
     }
 }

@@ -113,8 +113,9 @@ fn main() {
     let tris: Vec<_> = scene.tris().collect();
     let (near, far) = scene.depth_range();
     let state = RenderState::new(near, far).expect("valid range");
+    // The default strategy (the fast tier), as a firmware gets it.
     let (frame, depth, stats) =
-        render::<PerPixel<DefaultRecip>>(&tris, state, WIDTH, HEIGHT, HEIGHT).expect("scene draws");
+        render::<wraster::recip::Fast>(&tris, state, WIDTH, HEIGHT, HEIGHT).expect("scene draws");
 
     // Error: the final stored code against the reference's code of the visible surface, at every drawn pixel.
     let reference = reference_frame(&tris, near, far, WIDTH as u32, HEIGHT as u32);
@@ -132,7 +133,7 @@ fn main() {
     let mut times: Vec<f64> = (0..31)
         .map(|_| {
             let t = Instant::now();
-            let r = render::<PerPixel<DefaultRecip>>(&tris, state, WIDTH, HEIGHT, HEIGHT)
+            let r = render::<wraster::recip::Fast>(&tris, state, WIDTH, HEIGHT, HEIGHT)
                 .expect("scene draws");
             std::hint::black_box(&r);
             t.elapsed().as_secs_f64() * 1e3

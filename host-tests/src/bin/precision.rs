@@ -2,7 +2,7 @@
 //! [--at d1,d2,...]`. For each format and distance (default: near, 100, 500, 1000, 5000, far) one line
 //! `format=<NAME> near=<n> far=<f> d=<d> stored=<fraction> step=<eye units>`, the step measured by decoding the
 //! neighbouring code (wraster::format). It also writes a log-log PNG of step against distance for every format,
-//! the analytic limits of shared/notes/precision.md drawn as lines under the measured points.
+//! the analytic limits of the precision notes in ARCHITECTURE.md drawn as lines under the measured points.
 
 use std::path::PathBuf;
 

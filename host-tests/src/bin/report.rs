@@ -649,7 +649,7 @@ fn main() {
         "\nScene pixels compared per combination: {}; stiff-suite pixels: {}.\n",
         combos[0].scenes.pixels, combos[0].stiff.pixels
     );
-    let _ = writeln!(md, "## Step against distance (near 10, far 10000)\n\nMeasured steps (dots, from neighbouring codes) over the analytic limits of shared/notes/precision.md (lines). `cargo run --release -p host-tests --bin precision -- --near 10 --far 10000` prints the numbers.\n\n![step against distance](step_10_10000.png)\n");
+    let _ = writeln!(md, "## Step against distance (near 10, far 10000)\n\nMeasured steps (dots, from neighbouring codes) over the analytic limits of the precision notes in ARCHITECTURE.md (lines). `cargo run --release -p host-tests --bin precision -- --near 10 --far 10000` prints the numbers.\n\n![step against distance](step_10_10000.png)\n");
     let _ = writeln!(md, "## Terrain depth error of the exact tier (W16, lerp64 seed + 1 Newton-Raphson step)\n\nPer pixel, |decoded W - exact W| / W on a log scale from 1e-6 (blue) to 1e-1 (red); largest {heat_max:.2e}. This is the W16 quantisation itself (half a code is 0.5 / 65535 of W_far, so the relative error grows towards the eye, 0.0076 at W = 10): the reciprocal adds no code error on this scene (every pixel where it shows the reference's surface holds the exact code).\n\n![terrain error](terrain_error.png)\n");
     let _ = writeln!(md, "## Stiff suite\n");
     for c in &stiff {
