@@ -41,7 +41,8 @@ fn main() -> ! {
         & all::<PrevPixel>(COLOR, DEPTH, &mut counter);
     // `--features f32-div` adds the f32-division reciprocal (one VDIV on this core), for comparison (README).
     #[cfg(feature = "f32-div")]
-    let ok = ok & all::<wraster::recip::PerPixel<wraster::recip::F32Div>>(COLOR, DEPTH, &mut counter);
+    let ok =
+        ok & all::<wraster::recip::PerPixel<wraster::recip::F32Div>>(COLOR, DEPTH, &mut counter);
     debug::exit(if ok {
         debug::EXIT_SUCCESS
     } else {
