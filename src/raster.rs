@@ -506,7 +506,8 @@ impl Plane {
         let gy = d2 * e1x - d1 * e2x;
         let area = g.area as u64;
         let (ax, ay) = (gx.unsigned_abs(), gy.unsigned_abs());
-        if ax + ay > (t_min >> 5) as u64 || ax >= area << 38 || ay >= area << 38 {
+        // `|g| < area 2^38`, written so that nothing overflows (`area << 38` would for areas above 2^26).
+        if ax + ay > (t_min >> 5) as u64 || (ax >> 38) >= area || (ay >> 38) >= area {
             return None;
         }
         let inv = (1u64 << 62) / area;
