@@ -17,6 +17,9 @@ branch 2, BL 3, BX/BLX 2; PUSH/POP/LDM/STM 1 + n). The QEMU M0 board is a Cortex
 there): the M0+ table is used because the RP2040 is the M0+ this crate targets."""
 import os, re, subprocess, sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from disasm import disassemble
+
 here = os.path.dirname(os.path.abspath(__file__))
 boards = os.path.dirname(here)
 board = sys.argv[1]
@@ -29,8 +32,6 @@ plugin = os.path.join('/tmp', 'wraster-insncount.so')
 if not os.path.exists(plugin):
     subprocess.run(['cc', '-shared', '-DQEMU_PLUGIN_VERSION=4', '-fPIC', '-O2', '-o', plugin,
                     os.path.join(here, 'insncount.c')], check=True)
-tools = [os.path.join(r, f) for r, _, fs in os.walk(os.path.expanduser('~/.rustup/toolchains')) for f in fs if f == 'llvm-objdump']
-objdump = tools[0] if tools else 'llvm-objdump'
 
 
 def cycles_of(mn, ops, taken):
@@ -82,20 +83,11 @@ for scene in scenes:
                          capture_output=True, text=True, check=True).stdout
     bench = [l for l in out.splitlines() if l.startswith('bench ')][0]
     f = dict(kv.split('=', 1) for kv in bench.split()[1:])
-    dis, func, path, cur, where = {}, {}, {}, '?', '?'
-    for line in subprocess.run([objdump, '-d', '-l', '--no-show-raw-insn', elf], capture_output=True, text=True).stdout.splitlines():
-        mm = re.match(r'^[0-9a-f]+ <(.*)>:', line)
-        if mm:
-            cur, where = mm.group(1), '?'
-            continue
-        mm = re.match(r'^; (/\S+?):(\d+)', line)
-        if mm:
-            where = mm.group(1)
-            continue
-        mm = re.match(r'\s*([0-9a-f]+):\s+(\S+)\s*(.*)', line)
-        if mm:
-            a = int(mm.group(1), 16)
-            dis[a], func[a], path[a] = (mm.group(2), mm.group(3).split('@')[0]), cur, where
+    dis, func, path = {}, {}, {}
+    for a, text, f_, p, _ in disassemble(elf):
+        parts = text.split('@')[0].split(None, 1)
+        if parts:
+            dis[a], func[a], path[a] = (parts[0], parts[1] if len(parts) > 1 else ''), f_, p
     cnt = {}
     for line in open(counts):
         a, c = line.split()

@@ -1,27 +1,20 @@
 #!/usr/bin/env python3
 """Instruction-level profile of a board run: `profile.py ELF COUNTS [N]` joins insncount's per-PC counts with the
 disassembly (llvm-objdump) and prints per-function totals and the N hottest instructions. Instructions, not cycles."""
-import re, subprocess, sys, glob, os
+import os, sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from disasm import disassemble
 
 elf, counts = sys.argv[1], sys.argv[2]
 top = int(sys.argv[3]) if len(sys.argv) > 3 else 60
-tools = glob.glob(os.path.expanduser('~/.rustup/toolchains/*/lib/rustlib/*/bin/llvm-objdump'))
-objdump = tools[0] if tools else 'llvm-objdump'
-dis, func, src, cur, where = {}, {}, {}, '?', '?'
-for line in subprocess.run([objdump, '-d', '-C', '-l', '--no-show-raw-insn', elf], capture_output=True, text=True).stdout.splitlines():
-    m = re.match(r'^[0-9a-f]+ <(.*)>:', line)
-    if m:
-        cur, where = m.group(1), '?'
-        continue
-    m = re.match(r'^; (/\S+?):(\d+)', line)
-    if m:
-        path = m.group(1)
-        where = ('wraster/' + path.split('/src/')[-1] if '/work/' in path and '/boards/' not in path else path.split('/')[-1]) + ':' + m.group(2)
-        continue
-    m = re.match(r'\s*([0-9a-f]+):\s+(.*)', line)
-    if m:
-        a = int(m.group(1), 16)
-        dis[a], func[a], src[a] = m.group(2).split('@')[0].strip(), cur, where
+dis, func, src = {}, {}, {}
+for a, text, f, path, line in disassemble(elf, '-C'):
+    if path == '?':
+        where = '?'
+    else:
+        where = ('wraster/' + path.split('/src/')[-1] if '/work/' in path and '/boards/' not in path else path.split('/')[-1]) + ':' + line
+    dis[a], func[a], src[a] = text.split('@')[0].strip(), f, where
 cnt = {}
 for line in open(counts):
     a, c = line.split()
