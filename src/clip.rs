@@ -1,6 +1,7 @@
 //! World-space triangles: transform to clip space, clip, map through the viewport, draw.
 //!
-//! Clipping is homogeneous (Sutherland-Hodgman in clip coordinates, before the divide), against the near W plane
+//! All in f32 (no f64, so no soft-float doubles on a microcontroller). Clipping is homogeneous (Sutherland-Hodgman in
+//! clip coordinates, before the divide), against the near W plane
 //! `w >= W_near` of the render state, so every vertex that reaches the rasterizer has a finite, positive RHW no
 //! larger than `1 / W_near`: a triangle crossing the near plane, or lying partly behind the eye, draws exactly its
 //! part in front of the near plane instead of wrapping around through infinity (the "flashing" triangles of naive
@@ -63,43 +64,39 @@ impl Viewport {
 }
 
 /// Guard band used for clipping, pixels (inside [`crate::GUARD_BAND`]).
-const CLIP_BAND: f64 = 4000.0;
+const CLIP_BAND: f32 = 4000.0;
 /// Up to 3 + one vertex per plane (5 planes).
 const MAX_VERTS: usize = 8;
 
-type Poly = ([[f64; 4]; MAX_VERTS], usize);
+/// A polygon vertex: clip-space `x, y, z, w`, then the barycentric weights of the source triangle's three vertices
+/// (for per-vertex colours).
+type PolyVertex = [f32; 7];
+/// The clipped polygon (`heapless`: a fixed capacity, no allocation).
+type Poly = heapless::Vec<PolyVertex, MAX_VERTS>;
 
-/// Keeps the part of `poly` where `dot(plane, v) + offset >= 0`.
-fn clip_plane(poly: &Poly, plane: [f64; 4], offset: f64) -> Poly {
-    let (vs, n) = poly;
-    let mut out = ([[0.0; 4]; MAX_VERTS], 0usize);
-    let dist = |v: &[f64; 4]| v.iter().zip(plane).map(|(a, b)| a * b).sum::<f64>() + offset;
-    for k in 0..*n {
-        let (a, b) = (vs[k], vs[(k + 1) % n]);
-        let (da, db) = (dist(&a), dist(&b));
-        if da >= 0.0 && out.1 < MAX_VERTS {
-            out.0[out.1] = a;
-            out.1 += 1;
-        }
-        if (da >= 0.0) != (db >= 0.0) && out.1 < MAX_VERTS {
-            let t = da / (da - db);
-            out.0[out.1] = core::array::from_fn(|i| a[i] + t * (b[i] - a[i]));
-            out.1 += 1;
-        }
-    }
-    out
+/// The clip planes and the viewport map, in f32, for one depth range and viewport.
+///
+/// Error of the f32 path against exact arithmetic: the transform is 3 products and 3 sums per coordinate (a
+/// relative error of about `4 * 2^-24` of the largest term), the map `x / w`, `- cx`, `* sx`, `+ X` adds 4 roundings:
+/// a screen position within about `|x_px| * 2^-21` px (`2e-3` px at the 4000 px guard band, `1e-4` px on a 320 px
+/// screen) and `rhw` within `2^-22` relative (`0.016` W16 code), far below the 1/512 px of the vertex snap.
+/// (`host-tests/tests/clip.rs` checks the drawn frames against an f64 ray caster.)
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Planes {
+    near: f32,
+    /// `x/w` in `[kx_lo, kx_hi]`, `y/w` in `[ky_lo, ky_hi]`: the guard band in projected units.
+    k: [f32; 4],
+    /// Screen `x = ox + (x/w) sx`, `y = oy - (y/w) sy`.
+    sx: f32,
+    sy: f32,
+    ox: f32,
+    oy: f32,
+    zmin: f32,
+    zscale: f32,
 }
 
-impl<R: WSpan> Rasterizer<R> {
-    /// Transforms, clips and maps a world-space triangle: the clipped polygon's vertices (a fan) and their count,
-    /// 0 when nothing is left. Every fan triangle is checked, so a later draw of them cannot fail on x or y.
-    fn clip_world<C: Copy>(
-        &self,
-        m: &Mat4,
-        vp: &Viewport,
-        p: &[[f32; 3]; 3],
-        color: C,
-    ) -> Result<([Vertex<C>; MAX_VERTS], usize), Error> {
+impl Planes {
+    pub(crate) fn new(near: f32, vp: &Viewport) -> Result<Planes, Error> {
         let vpf = [
             vp.x,
             vp.y,
@@ -112,64 +109,162 @@ impl<R: WSpan> Rasterizer<R> {
             vp.min_z,
             vp.max_z,
         ];
-        if p.iter()
-            .flatten()
-            .chain(m.0.iter().flatten())
-            .chain(vpf.iter())
-            .any(|v| !v.is_finite())
-        {
+        if vpf.iter().any(|v| !v.is_finite()) {
             return Err(Error::NonFinite);
         }
-        let mut poly: Poly = ([[0.0; 4]; MAX_VERTS], 3);
-        for (k, q) in p.iter().enumerate() {
-            for c in 0..4 {
-                poly.0[k][c] =
-                    (0..3).map(|r| q[r] as f64 * m.0[r][c] as f64).sum::<f64>() + m.0[3][c] as f64;
-            }
-        }
-        let near = self.state.range.near() as f64;
-        // screen x = X + (x/w - cx) sx, screen y = Y + (cy - y/w) sy
-        let (sx, sy) = (
-            vp.width as f64 / vp.clip_width as f64,
-            vp.height as f64 / vp.clip_height as f64,
-        );
-        let (cx, cy) = (vp.clip_x as f64, vp.clip_y as f64);
+        let (sx, sy) = (vp.width / vp.clip_width, vp.height / vp.clip_height);
         if !(sx.is_finite() && sy.is_finite() && sx > 0.0 && sy > 0.0) {
             return Err(Error::NonFinite);
         }
-        // the guard band in projected units: x/w in [kx_lo, kx_hi], y/w in [ky_lo, ky_hi]
-        let kx_hi = cx + (CLIP_BAND - vp.x as f64) / sx;
-        let kx_lo = cx + (-CLIP_BAND - vp.x as f64) / sx;
-        let ky_lo = cy - (CLIP_BAND - vp.y as f64) / sy;
-        let ky_hi = cy - (-CLIP_BAND - vp.y as f64) / sy;
-        // the near W plane (w - W_near >= 0), then the guard band's four planes
-        for (plane, offset) in [
-            ([0.0, 0.0, 0.0, 1.0], -near),
-            ([-1.0, 0.0, 0.0, kx_hi], 0.0),
-            ([1.0, 0.0, 0.0, -kx_lo], 0.0),
-            ([0.0, -1.0, 0.0, ky_hi], 0.0),
-            ([0.0, 1.0, 0.0, -ky_lo], 0.0),
-        ] {
-            poly = clip_plane(&poly, plane, offset);
-            if poly.1 < 3 {
-                return Ok(([Vertex::new(0.0, 0.0, 1.0, color); MAX_VERTS], 0));
-            }
+        let (cx, cy) = (vp.clip_x, vp.clip_y);
+        let k = [
+            cx + (-CLIP_BAND - vp.x) / sx,
+            cx + (CLIP_BAND - vp.x) / sx,
+            cy - (CLIP_BAND - vp.y) / sy,
+            cy - (-CLIP_BAND - vp.y) / sy,
+        ];
+        let (ox, oy) = (vp.x - cx * sx, vp.y + cy * sy);
+        if !(k.iter().all(|v| v.is_finite()) && ox.is_finite() && oy.is_finite()) {
+            return Err(Error::NonFinite);
         }
-        let verts: [Vertex<C>; MAX_VERTS] = core::array::from_fn(|k| {
-            let [x, y, z, w] = poly.0[k];
-            Vertex {
-                x: (vp.x as f64 + (x / w - cx) * sx) as f32,
-                y: (vp.y as f64 + (cy - y / w) * sy) as f32,
-                z: (vp.min_z as f64 + z / w * (vp.max_z as f64 - vp.min_z as f64)) as f32,
-                rhw: (1.0 / w) as f32,
-                color,
-            }
-        });
-        // Check every fan triangle before drawing any, so an error writes nothing.
-        for k in 1..poly.1 - 1 {
-            crate::row_range(&[verts[0], verts[k], verts[k + 1]])?;
+        Ok(Planes {
+            near,
+            k,
+            sx,
+            sy,
+            ox,
+            oy,
+            zmin: vp.min_z,
+            zscale: vp.max_z - vp.min_z,
+        })
+    }
+
+    /// Signed distance of `c` to plane `p` (inside when `>= 0`): the near W plane, then the guard band's four.
+    #[inline]
+    fn dist(&self, p: usize, c: &[f32]) -> f32 {
+        match p {
+            0 => c[3] - self.near,
+            1 => c[0] - self.k[0] * c[3],
+            2 => self.k[1] * c[3] - c[0],
+            3 => c[1] - self.k[2] * c[3],
+            _ => self.k[3] * c[3] - c[1],
         }
-        Ok((verts, poly.1))
+    }
+
+    /// Bit `p` set when `c` is outside plane `p`. A NaN distance (an overflow) counts as outside.
+    #[inline]
+    pub(crate) fn outcode(&self, c: &[f32; 4]) -> u8 {
+        (0..5).fold(0, |o, p| o | (u8::from(!(self.dist(p, c) >= 0.0)) << p))
+    }
+
+    /// Screen `x, y`, the viewport's `z`, and `rhw` of a clip-space point inside every plane. The clip keeps the
+    /// point in the guard band and in front of the near plane mathematically; the clamps only absorb f32 rounding
+    /// (a point computed a rounding outside), so that no clipped vertex is refused by the rasterizer.
+    #[inline]
+    pub(crate) fn map(&self, c: &[f32]) -> [f32; 4] {
+        let w = c[3].max(self.near);
+        let rhw = 1.0 / w;
+        let x = (self.ox + c[0] * rhw * self.sx).clamp(-CLIP_BAND, CLIP_BAND);
+        let y = (self.oy - c[1] * rhw * self.sy).clamp(-CLIP_BAND, CLIP_BAND);
+        [x, y, self.zmin + c[2] * rhw * self.zscale, rhw]
+    }
+
+    /// Clips triangle `c` (clip space) against the five planes (Sutherland-Hodgman), `out` the triangle's outcodes
+    /// or'ed. [`Error::WorldTooLarge`] when a distance overflows f32.
+    pub(crate) fn clip(&self, c: &[[f32; 4]; 3], out: u8) -> Result<Poly, Error> {
+        let mut poly = Poly::new();
+        for (k, v) in c.iter().enumerate() {
+            let mut pv = [0.0; 7];
+            pv[..4].copy_from_slice(v);
+            pv[4 + k] = 1.0;
+            let _ = poly.push(pv);
+        }
+        for p in 0..5 {
+            if out & (1 << p) == 0 {
+                continue;
+            }
+            let mut next = Poly::new();
+            let n = poly.len();
+            for k in 0..n {
+                let (a, b) = (&poly[k], &poly[(k + 1) % n]);
+                let (da, db) = (self.dist(p, a), self.dist(p, b));
+                if !(da.is_finite() && db.is_finite()) {
+                    return Err(Error::WorldTooLarge);
+                }
+                if da >= 0.0 {
+                    let _ = next.push(*a);
+                }
+                if (da >= 0.0) != (db >= 0.0) {
+                    let t = da / (da - db);
+                    let _ = next.push(core::array::from_fn(|i| a[i] + t * (b[i] - a[i])));
+                }
+            }
+            if next.len() < 3 {
+                return Ok(Poly::new());
+            }
+            poly = next;
+        }
+        Ok(poly)
+    }
+}
+
+/// `[x, y, z, 1] * m`; `Err(NonFinite)` for a non-finite input, `Err(WorldTooLarge)` when the product overflows.
+#[inline]
+pub(crate) fn to_clip(m: &Mat4, q: &[f32; 3]) -> Result<[f32; 4], Error> {
+    if !q.iter().all(|v| v.is_finite()) {
+        return Err(Error::NonFinite);
+    }
+    let c: [f32; 4] = core::array::from_fn(|i| {
+        q[0] * m.0[0][i] + q[1] * m.0[1][i] + q[2] * m.0[2][i] + m.0[3][i]
+    });
+    if c.iter().all(|v| v.is_finite()) {
+        Ok(c)
+    } else {
+        Err(Error::WorldTooLarge)
+    }
+}
+
+/// Checks a matrix.
+pub(crate) fn check_matrix(m: &Mat4) -> Result<(), Error> {
+    if m.0.iter().flatten().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(Error::NonFinite)
+    }
+}
+
+/// The fan triangle `(0, k, k + 1)` of a clipped polygon as vertices, their colours from `color` (given the
+/// barycentric weights of the source triangle's vertices).
+pub(crate) fn fan<C>(
+    planes: &Planes,
+    poly: &Poly,
+    k: usize,
+    color: &impl Fn([f32; 3]) -> C,
+) -> [Vertex<C>; 3] {
+    [0, k, k + 1].map(|i| {
+        let pv = &poly[i];
+        let [x, y, z, rhw] = planes.map(pv);
+        Vertex {
+            x,
+            y,
+            z,
+            rhw,
+            color: color([pv[4], pv[5], pv[6]]),
+        }
+    })
+}
+
+impl<R: WSpan> Rasterizer<R> {
+    /// Transforms, clips and maps a world-space triangle: the clipped polygon, empty when nothing is left.
+    fn clip_world(&self, m: &Mat4, vp: &Viewport, p: &[[f32; 3]; 3]) -> Result<(Planes, Poly), Error> {
+        check_matrix(m)?;
+        let planes = Planes::new(self.state.range.near(), vp)?;
+        let c = [to_clip(m, &p[0])?, to_clip(m, &p[1])?, to_clip(m, &p[2])?];
+        let codes = c.map(|v| planes.outcode(&v));
+        if codes[0] & codes[1] & codes[2] != 0 {
+            return Ok((planes, Poly::new()));
+        }
+        Ok((planes, planes.clip(&c, codes[0] | codes[1] | codes[2])?))
     }
 
     /// [`Rasterizer::draw_world`] into a depth buffer of any format (or none), with this rasterizer's W strategy.
@@ -187,14 +282,11 @@ impl<R: WSpan> Rasterizer<R> {
         D: DrawTarget,
         D::Color: PixelColor,
     {
-        let (verts, n) = self.clip_world(m, vp, p, color)?;
+        let (planes, poly) = self.clip_world(m, vp, p)?;
         let mut stats = Stats::default();
-        for k in 1..n.saturating_sub(1) {
-            stats += self.draw_format(
-                target,
-                depth.as_deref_mut(),
-                &[verts[0], verts[k], verts[k + 1]],
-            )?;
+        for k in 1..poly.len().saturating_sub(1) {
+            let v = fan(&planes, &poly, k, &|_| color);
+            stats += self.draw_format(target, depth.as_deref_mut(), &v)?;
         }
         Ok(stats)
     }
@@ -202,8 +294,10 @@ impl<R: WSpan> Rasterizer<R> {
 
 impl<R: SpanRecip> Rasterizer<R> {
     /// Draws a world-space triangle (`p` as `[x, y, z]`, transformed as row vectors `[x, y, z, 1] * m`, `m` the
-    /// world-to-clip matrix) with flat colour `color`, clipped as the module says, into a W16 buffer (the lean path).
-    /// On an error nothing is written.
+    /// world-to-clip matrix) with flat colour `color`, clipped as the module says, into a W16 buffer (the lean path),
+    /// all in f32. Errors before anything is written: [`Error::NonFinite`] for a NaN or an infinity in `p`, `m` or
+    /// `vp`, [`Error::WorldTooLarge`] when a transformed coordinate overflows f32 (any finite triangle whose clip
+    /// coordinates stay below about `1e37` draws its visible part). A failing `target` is as [`Rasterizer::draw`]'s.
     pub fn draw_world<D>(
         &mut self,
         target: &mut D,
@@ -217,10 +311,11 @@ impl<R: SpanRecip> Rasterizer<R> {
         D: DrawTarget,
         D::Color: PixelColor,
     {
-        let (verts, n) = self.clip_world(m, vp, p, color)?;
+        let (planes, poly) = self.clip_world(m, vp, p)?;
         let mut stats = Stats::default();
-        for k in 1..n.saturating_sub(1) {
-            stats += self.draw(target, depth, &[verts[0], verts[k], verts[k + 1]])?;
+        for k in 1..poly.len().saturating_sub(1) {
+            let v = fan(&planes, &poly, k, &|_| color);
+            stats += self.draw(target, depth, &v)?;
         }
         Ok(stats)
     }

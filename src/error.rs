@@ -27,6 +27,14 @@ pub enum Error {
     Target,
     /// Z buffering asked for with a depth format that stores W (see [`crate::DepthMode`]).
     ZWithWFormat,
+    /// A camera that cannot be built: `look_at` with the eye on the target or `up` along the view direction, a
+    /// field of view outside `(0, pi)` radians (given in degrees, say), or `aspect <= 0`.
+    InvalidCamera,
+    /// A world-space vertex whose clip-space coordinates (after the matrix) are not finite in f32, or whose
+    /// clipping overflows f32: the coordinates or the matrix are too large (about `1e38` after the transform).
+    WorldTooLarge,
+    /// A mesh index at or beyond the number of vertices, or a per-face colour slice shorter than the faces.
+    IndexOutOfRange,
 }
 
 impl fmt::Display for Error {
@@ -52,6 +60,15 @@ impl fmt::Display for Error {
             Error::Target => f.write_str("the draw target returned an error"),
             Error::ZWithWFormat => {
                 f.write_str("Z buffering asked for with a depth format that stores W")
+            }
+            Error::InvalidCamera => f.write_str(
+                "camera: eye on target, up along the view, fov outside (0, pi) radians or aspect <= 0",
+            ),
+            Error::WorldTooLarge => {
+                f.write_str("world vertex too large: clip-space coordinates overflow f32")
+            }
+            Error::IndexOutOfRange => {
+                f.write_str("mesh index beyond the vertices, or too few face colours")
             }
         }
     }

@@ -80,6 +80,7 @@ mod error;
 mod fast;
 mod fixed;
 pub mod format;
+pub mod mesh;
 pub mod packed;
 pub mod projection;
 mod raster;

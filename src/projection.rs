@@ -2,7 +2,7 @@
 //! Matrices are row-major and apply to row vectors, `v' = v * M`, as in the seeds: `m[r][c]` is Direct3D's
 //! `_rc` with both indices from 0, so `_34` is `m[2][3]`.
 
-use crate::Error;
+use crate::{Error, RenderState};
 
 /// A 4x4 matrix for row vectors (`v * M`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,37 +40,263 @@ impl Mat4 {
     }
 }
 
-/// `sin` and `cos` of `x` in `[-4, 4]` by their Taylor series in f64 (terms to `x^25`: error below `1e-12`), so
-/// `core` needs no float library.
-fn sin_cos(x: f64) -> (f64, f64) {
-    let (mut s, mut c, mut term_s, mut term_c) = (0.0, 0.0, x, 1.0);
-    for k in 0..13 {
-        s += term_s;
-        c += term_c;
-        let (a, b) = ((2 * k + 2) as f64, (2 * k + 3) as f64);
-        term_s *= -x * x / (a * b);
-        term_c *= -x * x / ((2 * k + 1) as f64 * a);
+/// `sin` and `cos` of `x` in f32, for `|x| <= 8192` (beyond, the argument reduction loses bits and the result is only
+/// bounded by 1): the argument is reduced by `pi/2` in three parts (Cody and Waite), then Taylor polynomials to `r^9`
+/// and `r^10` on `|r| <= pi/4` (truncation below `2e-9`). Error below `4e-7` absolute (five f32 roundings of terms
+/// at most 1, `5 * 2^-24 = 3e-7`, plus the truncation), checked against f64 in the tests. micromath's `sin`/`cos`
+/// document an error of 0.002: too coarse for a projection's planes or a rotation that a test compares with f64.
+pub fn sin_cos(x: f32) -> (f32, f32) {
+    // pi/2 = P1 + P2 + P3, P1 and P2 with 12 trailing zero bits so k * P1 and k * P2 are exact for k < 2^12.
+    const P1: f32 = 1.570_312_5;
+    const P2: f32 = 4.838_267_9e-4;
+    const P3: f32 = 6.077_100_5e-11;
+    let k = {
+        let q = x * core::f32::consts::FRAC_2_PI;
+        // round half away from zero, without `f32::round` (std)
+        let r = if q >= 0.0 { q + 0.5 } else { q - 0.5 };
+        if r.is_finite() && r.abs() < 8.0e6 {
+            r as i32
+        } else {
+            0
+        }
+    };
+    let kf = k as f32;
+    let r = ((x - kf * P1) - kf * P2) - kf * P3;
+    let r2 = r * r;
+    let s = r * (1.0 + r2 * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0 + r2 / 362_880.0))));
+    let c = 1.0
+        + r2 * (-0.5
+            + r2 * (1.0 / 24.0
+                + r2 * (-1.0 / 720.0 + r2 * (1.0 / 40_320.0 - r2 / 3_628_800.0))));
+    match k & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
     }
-    (s, c)
 }
 
-/// `D3DUtil_SetProjectionMatrix` (Rogers): `_11 = cos(fov/2) * aspect`, `_22 = cos(fov/2)`,
-/// `_33 = Q = far sin(fov/2) / (far - near)`, `_34 = sin(fov/2)`, `_43 = -Q near`. Its `E_INVALIDARG` when
-/// `far - near < 0.01` is [`Error::InvalidDepthRange`]; a field of view outside `(0, pi)` or a non-finite input is
-/// [`Error::NonFinite`]. (This matrix has `W = z sin(fov/2)`: its W planes are `near sin`, `far sin`, and it is not
-/// W-friendly in Dunlop's "Using W-Buffers" sense.)
-pub fn perspective(fov: f32, aspect: f32, near: f32, far: f32) -> Result<Mat4, Error> {
+/// `sqrt(x)` for `x >= 0` in f32: micromath's estimate (a shift of the bits, documented deviation ~5%) refined by
+/// three Newton steps, each of which squares the relative error (`0.05 -> 1.3e-3 -> 7.8e-7 -> 3e-13`), so the
+/// result is within an f32 rounding or two. 0 for `x <= 0` or NaN.
+pub fn sqrt(x: f32) -> f32 {
+    if !(x > 0.0) {
+        return 0.0;
+    }
+    let mut y = micromath::F32(x).sqrt().0;
+    for _ in 0..3 {
+        y = 0.5 * (y + x / y);
+    }
+    y
+}
+
+fn sub3(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn cross3(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn dot3(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn unit(a: [f32; 3]) -> Option<[f32; 3]> {
+    let n = sqrt(dot3(a, a));
+    (n > 0.0 && n.is_finite()).then(|| a.map(|c| c / n))
+}
+
+impl Mat4 {
+    /// Translation by `t`.
+    pub fn translation(t: [f32; 3]) -> Mat4 {
+        let mut m = Mat4::IDENTITY;
+        m.0[3] = [t[0], t[1], t[2], 1.0];
+        m
+    }
+    /// Scale by `s` along each axis.
+    pub fn scale(s: [f32; 3]) -> Mat4 {
+        let mut m = Mat4::IDENTITY;
+        m.0[0][0] = s[0];
+        m.0[1][1] = s[1];
+        m.0[2][2] = s[2];
+        m
+    }
+    /// Rotation by `a` radians about the x axis, counter-clockwise seen from `+x` (right-handed):
+    /// `y' = y cos a - z sin a`, `z' = y sin a + z cos a`. `sin` and `cos` by [`sin_cos`].
+    pub fn rotation_x(a: f32) -> Mat4 {
+        let (s, c) = sin_cos(a);
+        let mut m = Mat4::IDENTITY;
+        m.0[1][1] = c;
+        m.0[1][2] = s;
+        m.0[2][1] = -s;
+        m.0[2][2] = c;
+        m
+    }
+    /// Rotation by `a` radians about the y axis (right-handed): `x' = x cos a + z sin a`, `z' = -x sin a + z cos a`.
+    pub fn rotation_y(a: f32) -> Mat4 {
+        let (s, c) = sin_cos(a);
+        let mut m = Mat4::IDENTITY;
+        m.0[0][0] = c;
+        m.0[0][2] = -s;
+        m.0[2][0] = s;
+        m.0[2][2] = c;
+        m
+    }
+    /// Rotation by `a` radians about the z axis (right-handed): `x' = x cos a - y sin a`, `y' = x sin a + y cos a`.
+    pub fn rotation_z(a: f32) -> Mat4 {
+        let (s, c) = sin_cos(a);
+        let mut m = Mat4::IDENTITY;
+        m.0[0][0] = c;
+        m.0[0][1] = s;
+        m.0[1][0] = -s;
+        m.0[1][1] = c;
+        m
+    }
+    /// The view matrix of an eye at `eye` looking at `target`, `up` giving the screen's up direction: eye space has
+    /// x to the right, y up and z (the eye depth, W after [`perspective`]) along the view direction. Works in a
+    /// right-handed world (the usual one: a mesh wound counter-clockwise seen from outside shows its front faces
+    /// counter-clockwise on screen, and [`Cull::Cw`](crate::Cull::Cw) drops the back faces).
+    /// [`Error::InvalidCamera`] when `eye == target` or `up` is parallel to the view direction; [`Error::NonFinite`]
+    /// for a NaN or an infinity.
+    pub fn look_at(eye: [f32; 3], target: [f32; 3], up: [f32; 3]) -> Result<Mat4, Error> {
+        if !eye.iter().chain(&target).chain(&up).all(|v| v.is_finite()) {
+            return Err(Error::NonFinite);
+        }
+        let f = unit(sub3(target, eye)).ok_or(Error::InvalidCamera)?;
+        let r = unit(cross3(f, up)).ok_or(Error::InvalidCamera)?;
+        let u = cross3(r, f);
+        Ok(Mat4([
+            [r[0], u[0], f[0], 0.0],
+            [r[1], u[1], f[1], 0.0],
+            [r[2], u[2], f[2], 0.0],
+            [-dot3(eye, r), -dot3(eye, u), -dot3(eye, f), 1.0],
+        ]))
+    }
+}
+
+/// `a * b`: apply `a`, then `b` (row vectors: `v * (a * b) = (v * a) * b`), as [`Mat4::then`].
+impl core::ops::Mul for Mat4 {
+    type Output = Mat4;
+    fn mul(self, rhs: Mat4) -> Mat4 {
+        self.then(&rhs)
+    }
+}
+
+/// A W-friendly perspective projection and the depth planes it was built with, so a [`RenderState`] taken from it
+/// cannot disagree with it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Perspective {
+    /// Eye space to clip space (row vectors): `w` out equals eye depth `z` in.
+    pub matrix: Mat4,
+    /// `W_near`: the near clip plane, in eye depth.
+    pub near: f32,
+    /// `W_far`: the far plane, in eye depth.
+    pub far: f32,
+}
+
+impl Perspective {
+    /// The render state for this projection: depth range `[near, far]`, `Less`, depth write, back faces of a
+    /// counter-clockwise mesh culled ([`Cull::Cw`](crate::Cull::Cw), see [`Mat4::look_at`]).
+    pub fn render_state(&self) -> Result<RenderState, Error> {
+        let mut s = RenderState::new(self.near, self.far)?;
+        s.cull = crate::Cull::Cw;
+        Ok(s)
+    }
+}
+
+/// A W-friendly perspective (Dunlop, "Using W-Buffers": fourth column `[0, 0, 1, 0]`, so clip `w` is the eye
+/// depth): `fov_y` the vertical field of view in radians, in `(0, pi)`; `aspect` = width / height (4/3 for
+/// 320 x 240), as OpenGL's `gluPerspective` and most libraries take it; `near` and `far` the eye depths of the
+/// planes. `x/w` and `y/w` are in `[-1, 1]` across the field of view and `z/w` in `[0, 1]` from near to far.
+/// `cot(fov_y / 2)` by [`sin_cos`] (4e-7), not micromath (0.002). Errors: [`Error::NonFinite`] for NaN or
+/// infinity, [`Error::InvalidCamera`] for a field of view outside `(0, pi)` (degrees, say) or `aspect <= 0`,
+/// [`Error::InvalidDepthRange`] as [`RenderState::new`].
+pub fn perspective(fov_y: f32, aspect: f32, near: f32, far: f32) -> Result<Perspective, Error> {
+    if !(fov_y.is_finite() && aspect.is_finite() && near.is_finite() && far.is_finite()) {
+        return Err(Error::NonFinite);
+    }
+    if !(fov_y > 0.0 && fov_y < core::f32::consts::PI && aspect > 0.0) {
+        return Err(Error::InvalidCamera);
+    }
+    crate::DepthRange::new(near, far)?;
+    let (s, c) = sin_cos(fov_y * 0.5);
+    let cot = c / s;
+    let q = far / (far - near);
+    Ok(Perspective {
+        matrix: Mat4([
+            [cot / aspect, 0.0, 0.0, 0.0],
+            [0.0, cot, 0.0, 0.0],
+            [0.0, 0.0, q, 1.0],
+            [0.0, 0.0, -q * near, 0.0],
+        ]),
+        near,
+        far,
+    })
+}
+
+/// A camera: where the eye is and its projection. [`Camera::matrix`] takes world space to clip space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// World to eye space ([`Mat4::look_at`]).
+    pub view: Mat4,
+    /// Eye to clip space.
+    pub projection: Perspective,
+}
+
+impl Camera {
+    /// An eye at `eye` looking at `target` (`up` up) through [`perspective`]`(fov_y, aspect, near, far)`.
+    pub fn look_at(
+        eye: [f32; 3],
+        target: [f32; 3],
+        up: [f32; 3],
+        fov_y: f32,
+        aspect: f32,
+        near: f32,
+        far: f32,
+    ) -> Result<Camera, Error> {
+        Ok(Camera {
+            view: Mat4::look_at(eye, target, up)?,
+            projection: perspective(fov_y, aspect, near, far)?,
+        })
+    }
+    /// World to clip space: `view * projection`.
+    pub fn matrix(&self) -> Mat4 {
+        self.view * self.projection.matrix
+    }
+    /// `model`, then this camera: object space to clip space.
+    pub fn model_matrix(&self, model: &Mat4) -> Mat4 {
+        *model * self.matrix()
+    }
+    /// [`Perspective::render_state`].
+    pub fn render_state(&self) -> Result<RenderState, Error> {
+        self.projection.render_state()
+    }
+}
+
+/// `D3DUtil_SetProjectionMatrix` (Rogers, "W-Buffering in Direct3D"), kept under its own name: `_11 = cos(fov/2) * aspect`,
+/// `_22 = cos(fov/2)`, `_33 = Q = far sin(fov/2) / (far - near)`, `_34 = sin(fov/2)`, `_43 = -Q near`. Its `aspect` is
+/// height / width (the seed's convention). Its `E_INVALIDARG` when `far - near < 0.01` is
+/// [`Error::InvalidDepthRange`]; a field of view outside `(0, pi)` or a non-finite input is [`Error::NonFinite`].
+/// (This matrix has `W = z sin(fov/2)`: its W planes are `near sin`, `far sin`, and it is not W-friendly in Dunlop's
+/// "Using W-Buffers" sense: use [`perspective`] with a W-buffer.)
+pub fn d3dutil_set_projection_matrix(
+    fov: f32,
+    aspect: f32,
+    near: f32,
+    far: f32,
+) -> Result<Mat4, Error> {
     if !(fov.is_finite() && aspect.is_finite() && near.is_finite() && far.is_finite()) {
         return Err(Error::NonFinite);
     }
     if far - near < 0.01 {
         return Err(Error::InvalidDepthRange);
     }
-    if fov <= 0.0 || fov as f64 >= core::f64::consts::PI {
+    if !(fov > 0.0 && fov < core::f32::consts::PI) {
         return Err(Error::NonFinite);
     }
-    let (sin, cos) = sin_cos(fov as f64 / 2.0);
-    let (sin, cos) = (sin as f32, cos as f32);
+    let (sin, cos) = sin_cos(fov / 2.0);
     let q = far * sin / (far - near);
     let mut m = [[0.0f32; 4]; 4];
     m[0][0] = cos * aspect;
@@ -85,15 +311,9 @@ pub fn perspective(fov: f32, aspect: f32, near: f32, far: f32) -> Result<Mat4, E
 /// `dvWNear = _44 - _43 / _33 * _34`, `dvWFar = (_44 - _43) / (_33 - _34) * _34 + _44`.
 /// A matrix for which they are not finite, or do not give `0 < W_near < W_far`, is an error.
 pub fn w_planes(m: &Mat4) -> Result<(f32, f32), Error> {
-    let (m33, m34, m43, m44) = (
-        m.at(3, 3) as f64,
-        m.at(3, 4) as f64,
-        m.at(4, 3) as f64,
-        m.at(4, 4) as f64,
-    );
+    let (m33, m34, m43, m44) = (m.at(3, 3), m.at(3, 4), m.at(4, 3), m.at(4, 4));
     let near = m44 - m43 / m33 * m34;
     let far = (m44 - m43) / (m33 - m34) * m34 + m44;
-    let (near, far) = (near as f32, far as f32);
     if !(near.is_finite() && far.is_finite()) {
         return Err(Error::NonFinite);
     }
@@ -159,19 +379,19 @@ mod tests {
         }
     }
 
-    /// D3DUtil_SetProjectionMatrix's W planes are `near sin(fov/2)` and `far sin(fov/2)` (derived in `perspective`'s
-    /// doc), to a few f32 roundings scaled by `far / (far - near)`.
+    /// D3DUtil_SetProjectionMatrix's W planes are `near sin(fov/2)` and `far sin(fov/2)` (derived in its doc), to a
+    /// few f32 roundings scaled by `far / (far - near)` and, for the far plane, `far / near` (`_33 - _34` cancels).
     #[test]
-    fn perspective_w_planes_and_error() {
+    fn d3dutil_w_planes_and_error() {
         for (fov, n, f) in [
             (1.0f32, 1.0f32, 100.0f32),
             (1.5, 10.0, 1000.0),
             (0.7, 0.1, 50.0),
         ] {
-            let m = perspective(fov, 4.0 / 3.0, n, f).unwrap();
-            let s = sin_cos(fov as f64 / 2.0).0 as f32;
+            let m = d3dutil_set_projection_matrix(fov, 4.0 / 3.0, n, f).unwrap();
+            let s = (fov as f64 / 2.0).sin() as f32;
             let (wn, wf) = w_planes(&m).unwrap();
-            assert!(close(wn, n * s, 8.0), "{wn} vs {}", n * s);
+            assert!(close(wn, n * s, 8.0 * f / (f - n)), "{wn} vs {}", n * s);
             assert!(
                 close(wf, f * s, 8.0 * f / (f - n) * (f / n)),
                 "{wf} vs {}",
@@ -180,11 +400,89 @@ mod tests {
             assert!(!is_w_friendly(&m));
         }
         assert_eq!(
-            perspective(1.0, 1.0, 1.0, 1.009),
+            d3dutil_set_projection_matrix(1.0, 1.0, 1.0, 1.009),
             Err(Error::InvalidDepthRange)
         );
-        assert!(perspective(1.0, 1.0, 1.0, 1.011).is_ok());
-        assert_eq!(perspective(f32::NAN, 1.0, 1.0, 10.0), Err(Error::NonFinite));
+        assert!(d3dutil_set_projection_matrix(1.0, 1.0, 1.0, 1.011).is_ok());
+        assert_eq!(
+            d3dutil_set_projection_matrix(f32::NAN, 1.0, 1.0, 10.0),
+            Err(Error::NonFinite)
+        );
+    }
+
+    /// The W-friendly perspective: `w` out is eye depth exactly (`_34 = 1`, `_44 = 0`), Rogers's formulas give its
+    /// planes back (`W_near = q n / q` to two roundings, `W_far` to a few scaled by `far / near`), its render state
+    /// has the same planes, and a field of view in degrees or a bad aspect is refused.
+    #[test]
+    fn w_friendly_perspective() {
+        for (fov, a, n, f) in [
+            (1.047_197_6f32, 4.0 / 3.0, 0.5f32, 100.0f32),
+            (1.5, 1.0, 10.0, 1000.0),
+            (0.3, 2.0, 0.1, 50.0),
+        ] {
+            let p = perspective(fov, a, n, f).unwrap();
+            assert!(is_w_friendly(&p.matrix));
+            let (wn, wf) = w_planes(&p.matrix).unwrap();
+            assert!(close(wn, n, 4.0), "{wn} vs {n}");
+            assert!(close(wf, f, 8.0 * f / n), "{wf} vs {f}");
+            let st = p.render_state().unwrap();
+            assert_eq!((st.range.near(), st.range.far()), (n, f));
+            // a point on the top edge of the field of view at depth 7 lands on y/w = 1, on the right edge x/w = 1
+            let t = (fov as f64 / 2.0).tan();
+            let top = p.matrix.transform([0.0, (7.0 * t) as f32, 7.0, 1.0]);
+            let right = p.matrix.transform([(7.0 * t * a as f64) as f32, 0.0, 7.0, 1.0]);
+            assert_eq!(top[3], 7.0);
+            assert!((top[1] / top[3] - 1.0).abs() < 2e-6 && (right[0] / right[3] - 1.0).abs() < 2e-6);
+        }
+        assert_eq!(perspective(60.0, 1.0, 1.0, 10.0), Err(Error::InvalidCamera));
+        assert_eq!(perspective(1.0, 0.0, 1.0, 10.0), Err(Error::InvalidCamera));
+        assert_eq!(perspective(1.0, 1.0, 10.0, 1.0), Err(Error::InvalidDepthRange));
+        assert_eq!(perspective(1.0, f32::INFINITY, 1.0, 10.0), Err(Error::NonFinite));
+    }
+
+    /// look_at: the eye maps to the origin, the target to `(0, 0, distance)`, `up` to `+y`; rotations are
+    /// right-handed and orthonormal to f32 rounding; `*` applies left then right.
+    #[test]
+    fn camera_and_transforms() {
+        let v = Mat4::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0]).unwrap();
+        assert_eq!(v.transform([0.0, 0.0, 3.0, 1.0]), [0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(v.transform([0.0, 0.0, 0.0, 1.0]), [0.0, 0.0, 3.0, 1.0]);
+        assert_eq!(v.transform([1.0, 1.0, 0.0, 1.0]), [1.0, 1.0, 3.0, 1.0]);
+        let v2 = Mat4::look_at([1.0, 2.0, 3.0], [-4.0, 0.5, 2.0], [0.0, 1.0, 0.0]).unwrap();
+        let d = v2.transform([-4.0, 0.5, 2.0, 1.0]);
+        let dist = (25.0f64 + 2.25 + 1.0).sqrt();
+        assert!(d[0].abs() < 1e-6 && d[1].abs() < 1e-6 && (d[2] as f64 - dist).abs() < 1e-5);
+        assert_eq!(
+            Mat4::look_at([1.0; 3], [1.0; 3], [0.0, 1.0, 0.0]),
+            Err(Error::InvalidCamera)
+        );
+        assert_eq!(
+            Mat4::look_at([0.0; 3], [0.0, 5.0, 0.0], [0.0, 1.0, 0.0]),
+            Err(Error::InvalidCamera)
+        );
+        let q = core::f32::consts::FRAC_PI_2;
+        let close3 = |a: [f32; 4], b: [f32; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-6);
+        assert!(close3(Mat4::rotation_z(q).transform([1.0, 0.0, 0.0, 1.0]), [0.0, 1.0, 0.0, 1.0]));
+        assert!(close3(Mat4::rotation_x(q).transform([0.0, 1.0, 0.0, 1.0]), [0.0, 0.0, 1.0, 1.0]));
+        assert!(close3(Mat4::rotation_y(q).transform([0.0, 0.0, 1.0, 1.0]), [1.0, 0.0, 0.0, 1.0]));
+        let m = Mat4::scale([2.0, 3.0, 4.0]) * Mat4::translation([1.0, 1.0, 1.0]);
+        assert_eq!(m.transform([1.0, 1.0, 1.0, 1.0]), [3.0, 4.0, 5.0, 1.0]);
+        let c = Camera::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 0.5, 100.0)
+            .unwrap();
+        assert_eq!(c.matrix().transform([0.0, 0.0, 1.0, 1.0])[3], 2.0);
+        assert_eq!(c.render_state().unwrap().cull, crate::Cull::Cw);
+    }
+
+    /// `sqrt` within two f32 roundings of the true root.
+    #[test]
+    fn newton_sqrt() {
+        for k in 1..2000 {
+            let x = k as f32 * 0.37 + 1e-3 * k as f32 * k as f32;
+            let e = ((sqrt(x) as f64 - (x as f64).sqrt()) / (x as f64).sqrt()).abs();
+            assert!(e <= 2.0 * f32::EPSILON as f64, "{x}: {e}");
+        }
+        assert_eq!(sqrt(-1.0), 0.0);
+        assert_eq!(sqrt(f32::NAN), 0.0);
     }
 
     #[test]
@@ -209,16 +507,18 @@ mod tests {
         assert_eq!(w_planes(&Mat4::IDENTITY), Err(Error::InvalidDepthRange));
     }
 
+    /// `sin_cos` within its documented 4e-7 of f64 over `[-100, 100]`.
     #[test]
-    fn series_sin_cos() {
-        for k in 0..=300 {
-            let x = -3.2 + k as f64 * 0.0213;
+    fn f32_sin_cos() {
+        let mut worst = 0.0f64;
+        for k in 0..=200_000 {
+            let x = -100.0f32 + k as f32 * 0.001;
             let (s, c) = sin_cos(x);
-            assert!(
-                (s - x.sin()).abs() < 1e-12 && (c - x.cos()).abs() < 1e-12,
-                "{x}"
-            );
+            let xd = x as f64;
+            worst = worst.max((s as f64 - xd.sin()).abs()).max((c as f64 - xd.cos()).abs());
         }
+        std::println!("sin_cos worst {worst:e} (bound 4e-7)");
+        assert!(worst < 4e-7, "{worst}");
     }
 
     #[test]

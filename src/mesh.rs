@@ -1,0 +1,324 @@
+//! Indexed triangle meshes drawn from world (or object) space with one call.
+//!
+//! [`Rasterizer::transform_mesh`] transforms each vertex once per frame into caller-provided storage (no
+//! allocation): screen `x`, `y` and `rhw` for a vertex in front of the near plane and inside the guard band, a mark
+//! for the others. [`Rasterizer::draw_mesh_frame`] then draws the triangles into a buffer or a band of one, as often as
+//! there are bands: a triangle whose three vertices are marked inside is binned by its rows (a band it cannot touch
+//! costs a compare), culled by the sign of its screen area, and drawn; the few others are transformed again from
+//! their positions, rejected when all three vertices lie outside one plane, culled by the sign of `det[x y w]` (the
+//! homogeneous back-face test, right for vertices behind the eye too) and clipped ([`crate::clip`]).
+//! [`Rasterizer::draw_mesh`] does both for a whole frame. Everything is f32; all checks happen in
+//! `transform_mesh`, before anything is drawn.
+//!
+//! ```
+//! use embedded_graphics_core::pixelcolor::Rgb565;
+//! use embedded_graphics_core::prelude::*;
+//! use wraster::clip::Viewport;
+//! use wraster::mesh::{Colors, Mesh, Projected};
+//! use wraster::projection::{Camera, Mat4};
+//! use wraster::{DepthStore, Rasterizer};
+//!
+//! # struct Screen;
+//! # impl OriginDimensions for Screen { fn size(&self) -> Size { Size::new(64, 48) } }
+//! # impl DrawTarget for Screen {
+//! #     type Color = Rgb565; type Error = core::convert::Infallible;
+//! #     fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(&mut self, _: I) -> Result<(), Self::Error> { Ok(()) }
+//! # }
+//! // A unit cube, counter-clockwise seen from outside.
+//! let positions = [
+//!     [-1.0, -1.0, -1.0], [1.0, -1.0, -1.0], [1.0, 1.0, -1.0], [-1.0, 1.0, -1.0],
+//!     [-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [1.0, 1.0, 1.0], [-1.0, 1.0, 1.0],
+//! ];
+//! let indices = [
+//!     [0, 3, 2], [0, 2, 1], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4],
+//!     [2, 3, 7], [2, 7, 6], [1, 2, 6], [1, 6, 5], [0, 4, 7], [0, 7, 3],
+//! ];
+//! let faces = [Rgb565::RED, Rgb565::RED, Rgb565::GREEN, Rgb565::GREEN, Rgb565::BLUE, Rgb565::BLUE,
+//!              Rgb565::CYAN, Rgb565::CYAN, Rgb565::WHITE, Rgb565::WHITE, Rgb565::YELLOW, Rgb565::YELLOW];
+//! let cube = Mesh { positions: &positions, indices: &indices, colors: Colors::PerFace(&faces) };
+//!
+//! let camera = Camera::look_at([3.0, 2.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0, 64.0 / 48.0, 0.5, 50.0)?;
+//! let mut r: Rasterizer = Rasterizer::new(camera.render_state()?);
+//! let mut depth = DepthStore::<64, 48>::new();
+//! let mut scratch = [Projected::default(); 8];
+//! let model = Mat4::rotation_y(0.3);
+//! let stats = r.draw_mesh(&mut Screen, &mut depth.view(), &cube, &camera.model_matrix(&model),
+//!                         &Viewport::new(0.0, 0.0, 64.0, 48.0), &mut scratch)?;
+//! assert_eq!(stats.culled, 6); // the six back-facing triangles
+//! assert!(stats.written > 200); // about a tenth of the 64 x 48 screen
+//! # Ok::<(), wraster::Error>(())
+//! ```
+
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::pixelcolor::PixelColor;
+
+use crate::clip::{check_matrix, fan, to_clip, Planes, Viewport};
+use crate::projection::Mat4;
+use crate::recip::{SpanRecip, WSpan};
+use crate::{Cull, DepthBuffer, Error, Rasterizer, Stats, Vertex};
+
+/// The colours of a mesh.
+#[derive(Clone, Copy, Debug)]
+pub enum Colors<'a, C> {
+    /// One colour for every triangle.
+    Uniform(C),
+    /// One colour per triangle (at least as many as `indices`).
+    PerFace(&'a [C]),
+    /// One colour per vertex (at least as many as `positions`): interpolated by
+    /// [`Rasterizer::draw_mesh_frame_gouraud`] (feature `gouraud`); the flat draws take a triangle's first vertex's
+    /// colour, as Direct3D's flat shading does.
+    PerVertex(&'a [C]),
+}
+
+/// An indexed triangle mesh: each triangle is three indices into `positions` (`u16`: up to 65,536 vertices).
+#[derive(Clone, Copy, Debug)]
+pub struct Mesh<'a, C> {
+    /// Vertex positions, object space.
+    pub positions: &'a [[f32; 3]],
+    /// Triangles, three indices each.
+    pub indices: &'a [[u16; 3]],
+    /// Colours.
+    pub colors: Colors<'a, C>,
+}
+
+/// A transformed vertex: screen `x`, `y` and `rhw` when it is in front of the near plane and inside the guard band;
+/// `rhw == 0` marks the others (the triangles using them are clipped from their positions). 12 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Projected {
+    /// Pixels, right.
+    pub x: f32,
+    /// Pixels, down.
+    pub y: f32,
+    /// `1 / W`, or 0 for a vertex that needs clipping.
+    pub rhw: f32,
+}
+
+/// A mesh transformed for one frame ([`Rasterizer::transform_mesh`]): draw it into each band with
+/// [`Rasterizer::draw_mesh_frame`].
+#[derive(Clone, Copy, Debug)]
+pub struct MeshFrame<'a, C> {
+    mesh: Mesh<'a, C>,
+    m: Mat4,
+    planes: Planes,
+    verts: &'a [Projected],
+}
+
+impl<'a, C: Copy> MeshFrame<'a, C> {
+    /// The mesh.
+    pub fn mesh(&self) -> &Mesh<'a, C> {
+        &self.mesh
+    }
+    /// The transformed vertices.
+    pub fn vertices(&self) -> &'a [Projected] {
+        self.verts
+    }
+
+    /// Triangle `k`'s per-vertex colours (the face colour three times for flat colours).
+    #[inline]
+    fn colors(&self, k: usize, idx: [usize; 3]) -> [C; 3] {
+        match self.mesh.colors {
+            Colors::Uniform(c) => [c; 3],
+            Colors::PerFace(f) => [f[k]; 3],
+            Colors::PerVertex(v) => idx.map(|i| v[i]),
+        }
+    }
+
+    /// Visits the triangles that can touch rows `[y0, y0 + h)`, culled and clipped, as screen-space triangles
+    /// (`f(vertices, per-vertex colours)` with the barycentric colour weights already applied by `mix`).
+    fn for_each<E>(
+        &self,
+        cull: Cull,
+        y0: i32,
+        h: u16,
+        stats: &mut Stats,
+        mix: &impl Fn([C; 3], [f32; 3]) -> C,
+        mut f: impl FnMut([Vertex<C>; 3]) -> Result<Stats, E>,
+    ) -> Result<(), E> {
+        // Rows whose centre can be covered: y in [y0 + 0.5, y0 + h - 0.5]; a pixel of slack for the snap.
+        let (top, bottom) = (y0 as f32 - 1.0, (y0 + h as i32) as f32 + 1.0);
+        for (k, tri) in self.mesh.indices.iter().enumerate() {
+            let idx = tri.map(|i| i as usize);
+            let [a, b, c] = idx.map(|i| self.verts[i]);
+            let vc = self.colors(k, idx);
+            if a.rhw > 0.0 && b.rhw > 0.0 && c.rhw > 0.0 {
+                let (ymin, ymax) = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
+                if ymax < top || ymin > bottom {
+                    continue;
+                }
+                let area = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+                if culled(cull, area) {
+                    stats.culled += 1;
+                    continue;
+                }
+                let v = [a, b, c];
+                *stats += f(core::array::from_fn(|i| Vertex {
+                    x: v[i].x,
+                    y: v[i].y,
+                    z: 0.0,
+                    rhw: v[i].rhw,
+                    color: vc[i],
+                }))?;
+                continue;
+            }
+            // Needs clipping: the positions were checked by transform_mesh, so these cannot fail.
+            let cl = idx.map(|i| to_clip(&self.m, &self.mesh.positions[i]).unwrap_or([0.0; 4]));
+            let codes = cl.map(|v| self.planes.outcode(&v));
+            if codes[0] & codes[1] & codes[2] != 0 {
+                continue;
+            }
+            // det [x y w]: its sign is the winding seen from the eye; on screen (y down) the area has the other sign.
+            let det = cl[0][0] * (cl[1][1] * cl[2][3] - cl[2][1] * cl[1][3])
+                - cl[1][0] * (cl[0][1] * cl[2][3] - cl[2][1] * cl[0][3])
+                + cl[2][0] * (cl[0][1] * cl[1][3] - cl[1][1] * cl[0][3]);
+            if culled(cull, -det) {
+                stats.culled += 1;
+                continue;
+            }
+            let Ok(poly) = self.planes.clip(&cl, codes[0] | codes[1] | codes[2]) else {
+                continue;
+            };
+            for j in 1..poly.len().saturating_sub(1) {
+                *stats += f(fan(&self.planes, &poly, j, &|w| mix(vc, w)))?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Whether a triangle with screen area `area` (y down; positive = clockwise on the display) is culled. A zero or NaN
+/// area is culled whatever the mode: it covers no pixel.
+#[inline]
+fn culled(cull: Cull, area: f32) -> bool {
+    match cull {
+        _ if !(area != 0.0) => true,
+        Cull::Cw => area > 0.0,
+        Cull::Ccw => area < 0.0,
+        Cull::None => false,
+    }
+}
+
+impl<R: WSpan> Rasterizer<R> {
+    /// Transforms `mesh` by `m` (object to clip space, row vectors; a camera's `model_matrix`) and maps it through
+    /// `vp` into `scratch` (at least one [`Projected`] per position), once per frame. Checks everything the draws
+    /// need, so a draw of the frame cannot fail on its input: [`Error::BufferSize`] for a short `scratch`,
+    /// [`Error::IndexOutOfRange`] for an index beyond `positions` or too few colours, [`Error::NonFinite`] for a
+    /// NaN or infinity in a position, `m` or `vp`, [`Error::WorldTooLarge`] for a vertex whose clip coordinates
+    /// overflow f32.
+    pub fn transform_mesh<'a, C: Copy>(
+        &self,
+        mesh: &Mesh<'a, C>,
+        m: &Mat4,
+        vp: &Viewport,
+        scratch: &'a mut [Projected],
+    ) -> Result<MeshFrame<'a, C>, Error> {
+        let n = mesh.positions.len();
+        if scratch.len() < n {
+            return Err(Error::BufferSize {
+                expected: n,
+                actual: scratch.len(),
+            });
+        }
+        let colors_ok = match mesh.colors {
+            Colors::Uniform(_) => true,
+            Colors::PerFace(f) => f.len() >= mesh.indices.len(),
+            Colors::PerVertex(v) => v.len() >= n,
+        };
+        if !colors_ok || mesh.indices.iter().flatten().any(|&i| i as usize >= n) {
+            return Err(Error::IndexOutOfRange);
+        }
+        check_matrix(m)?;
+        let planes = Planes::new(self.state.range.near(), vp)?;
+        for (p, s) in mesh.positions.iter().zip(scratch.iter_mut()) {
+            let c = to_clip(m, p)?;
+            *s = if planes.outcode(&c) == 0 {
+                let [x, y, _, rhw] = planes.map(&c);
+                Projected { x, y, rhw }
+            } else {
+                Projected::default()
+            };
+        }
+        Ok(MeshFrame {
+            mesh: *mesh,
+            m: *m,
+            planes,
+            verts: &scratch[..n],
+        })
+    }
+}
+
+impl<R: SpanRecip> Rasterizer<R> {
+    /// Draws a transformed mesh into `depth` (a whole frame or a band: only the triangles that can touch its rows
+    /// are set up), flat-shaded, back faces dropped as the render state's [`Cull`] says. With the render state the
+    /// frame was transformed with, it fails only when `target` fails (then as [`Rasterizer::draw`] says).
+    pub fn draw_mesh_frame<D>(
+        &mut self,
+        target: &mut D,
+        depth: &mut DepthBuffer<'_>,
+        frame: &MeshFrame<'_, D::Color>,
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        let mut stats = Stats::default();
+        let (y0, h, cull) = (depth.y0(), depth.height(), self.state.cull);
+        frame.for_each(cull, y0, h, &mut stats, &|c, _| c[0], |v| {
+            self.draw(target, depth, &v)
+        })?;
+        Ok(stats)
+    }
+
+    /// [`Rasterizer::transform_mesh`] then [`Rasterizer::draw_mesh_frame`]: a whole frame in one call.
+    pub fn draw_mesh<D>(
+        &mut self,
+        target: &mut D,
+        depth: &mut DepthBuffer<'_>,
+        mesh: &Mesh<'_, D::Color>,
+        m: &Mat4,
+        vp: &Viewport,
+        scratch: &mut [Projected],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        let frame = self.transform_mesh(mesh, m, vp, scratch)?;
+        self.draw_mesh_frame(target, depth, &frame)
+    }
+
+    /// [`Rasterizer::draw_mesh_frame`] with per-vertex colours interpolated perspective-correctly
+    /// ([`Rasterizer::draw_gouraud`], feature `gouraud`); a clipped vertex's colour is the mix of the triangle's
+    /// three by its barycentric weights in clip space.
+    #[cfg(feature = "gouraud")]
+    pub fn draw_mesh_frame_gouraud<D>(
+        &mut self,
+        target: &mut D,
+        depth: &mut DepthBuffer<'_>,
+        frame: &MeshFrame<'_, D::Color>,
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor
+            + From<embedded_graphics_core::pixelcolor::Rgb888>
+            + Into<embedded_graphics_core::pixelcolor::Rgb888>,
+    {
+        use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
+        let mix = |c: [D::Color; 3], w: [f32; 3]| {
+            let rgb = c.map(|c| {
+                let c: Rgb888 = c.into();
+                [c.r() as f32, c.g() as f32, c.b() as f32]
+            });
+            let ch = |i: usize| {
+                let v = w[0] * rgb[0][i] + w[1] * rgb[1][i] + w[2] * rgb[2][i] + 0.5;
+                v.clamp(0.0, 255.0) as u8
+            };
+            D::Color::from(Rgb888::new(ch(0), ch(1), ch(2)))
+        };
+        let mut stats = Stats::default();
+        let (y0, h, cull) = (depth.y0(), depth.height(), self.state.cull);
+        frame.for_each(cull, y0, h, &mut stats, &mix, |v| {
+            self.draw_gouraud(target, depth, &v)
+        })?;
+        Ok(stats)
+    }
+}
