@@ -288,3 +288,90 @@ fn terrain(k: usize) -> Tri {
         [v(0), v(1), v(2)]
     }
 }
+
+/// W4 "torus": a rotating mesh drawn from world space (transform, cull, clip, rasterise), as the benchmark workloads
+/// define it (README, "Standard scenes"): 320 x 240, depth cleared to the far plane before each of 8 frames, `Less`.
+pub mod torus {
+    use embedded_graphics_core::pixelcolor::Rgb565;
+
+    use crate::projection::{sin_cos, Camera, Mat4};
+    use crate::Error;
+
+    /// Major radius.
+    pub const R: f32 = 1.0;
+    /// Minor radius.
+    pub const MINOR: f32 = 0.35;
+    /// Segments around the major circle (`i`).
+    pub const SEG_I: usize = 32;
+    /// Segments around the minor circle (`j`).
+    pub const SEG_J: usize = 16;
+    /// Vertices.
+    pub const VERTICES: usize = SEG_I * SEG_J;
+    /// Triangles.
+    pub const TRIANGLES: usize = 2 * SEG_I * SEG_J;
+    /// Frames of the benchmark.
+    pub const FRAMES: usize = 8;
+    /// `W_near`, `W_far`.
+    pub const DEPTH: (f32, f32) = (0.5, 100.0);
+
+    /// The palette (RGB565), triangle `k` takes entry `k mod 8`.
+    pub const PALETTE: [u16; 8] = [
+        0xF800, 0x07E0, 0x001F, 0xFFE0, 0x07FF, 0xF81F, 0xFD20, 0x8410,
+    ];
+
+    /// Vertex `(i, j)` at index `j * SEG_I + i`: `((R + r cos phi) cos theta, (R + r cos phi) sin theta, r sin phi)`,
+    /// `theta = 2 pi i / 32`, `phi = 2 pi j / 16`, with [`sin_cos`] (f32, so the same bits on every core).
+    pub fn positions() -> [[f32; 3]; VERTICES] {
+        core::array::from_fn(|k| {
+            let (i, j) = (k % SEG_I, k / SEG_I);
+            let tau = 2.0 * core::f32::consts::PI;
+            let (st, ct) = sin_cos(tau * i as f32 / SEG_I as f32);
+            let (sp, cp) = sin_cos(tau * j as f32 / SEG_J as f32);
+            let ring = R + MINOR * cp;
+            [ring * ct, ring * st, MINOR * sp]
+        })
+    }
+
+    /// Quad `(i, j)` (row-major, `j` outer) is `(i,j) (i+1,j) (i+1,j+1)` and `(i,j) (i+1,j+1) (i,j+1)`, indices
+    /// mod 32 and mod 16: counter-clockwise seen from outside.
+    pub fn indices() -> [[u16; 3]; TRIANGLES] {
+        core::array::from_fn(|k| {
+            let (q, second) = (k / 2, k % 2 == 1);
+            let (i, j) = (q % SEG_I, q / SEG_I);
+            let v = |di: usize, dj: usize| {
+                (((j + dj) % SEG_J) * SEG_I + (i + di) % SEG_I) as u16
+            };
+            if second {
+                [v(0, 0), v(1, 1), v(0, 1)]
+            } else {
+                [v(0, 0), v(1, 0), v(1, 1)]
+            }
+        })
+    }
+
+    /// Triangle `k`'s colour.
+    pub fn colors() -> [Rgb565; TRIANGLES] {
+        core::array::from_fn(|k| {
+            embedded_graphics_core::pixelcolor::raw::RawU16::new(PALETTE[k % 8]).into()
+        })
+    }
+
+    /// Frame `k`'s model matrix: about x by `0.35 k` rad, then about y by `0.6 k` rad.
+    pub fn model(k: usize) -> Mat4 {
+        Mat4::rotation_x(0.35 * k as f32) * Mat4::rotation_y(0.6 * k as f32)
+    }
+
+    /// Eye at `(0, 0, 3)` looking at the origin, up `+y`, vertical field of view 60 degrees, aspect 4:3,
+    /// `W_near = 0.5`, `W_far = 100`.
+    pub fn camera() -> Result<Camera, Error> {
+        Camera::look_at(
+            [0.0, 0.0, 3.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            core::f32::consts::FRAC_PI_3,
+            4.0 / 3.0,
+            DEPTH.0,
+            DEPTH.1,
+        )
+    }
+}

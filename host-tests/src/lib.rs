@@ -414,3 +414,55 @@ impl Rng {
         (self.f(lo.ln(), hi.ln())).exp()
     }
 }
+
+/// FNV-1a 64 of a frame, continuing `hash`, as the boards compute it (boards/common): for each row, its RGB565
+/// colours then its W16 depths, u16 little-endian.
+pub fn hash_frame(hash: &mut u64, frame: &Frame, depth: &[u16]) {
+    use embedded_graphics::pixelcolor::IntoStorage;
+    let mut words = |ws: &mut dyn Iterator<Item = u16>| {
+        for w in ws {
+            for b in w.to_le_bytes() {
+                *hash ^= b as u64;
+                *hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        }
+    };
+    let w = frame.w as usize;
+    for row in 0..frame.h as usize {
+        words(&mut frame.px[row * w..(row + 1) * w].iter().map(|c| c.into_storage()));
+        words(&mut depth[row * w..(row + 1) * w].iter().copied());
+    }
+}
+
+/// W4 frame `k` (`wraster::scenes::torus`) through the mesh path, transformed once and drawn in bands of `band_h`
+/// rows (the last may be shorter), each band's depth cleared first: the frame, its depth, the summed stats.
+pub fn render_torus<R: SpanRecip>(k: usize, band_h: u16) -> Result<(Frame, Vec<u16>, Stats), Error> {
+    use wraster::clip::Viewport;
+    use wraster::mesh::{Colors, Mesh, Projected};
+    use wraster::scenes::{torus, HEIGHT, WIDTH};
+    let (pos, idx, col) = (torus::positions(), torus::indices(), torus::colors());
+    let mesh = Mesh {
+        positions: &pos,
+        indices: &idx,
+        colors: Colors::PerFace(&col),
+    };
+    let cam = torus::camera()?;
+    let (w, h) = (WIDTH, HEIGHT);
+    let mut frame = Frame::new(w as u32, h as u32);
+    let mut depth = vec![0u16; w as usize * h as usize];
+    let mut r = Rasterizer::<R>::new(cam.render_state()?);
+    let mut scratch = vec![Projected::default(); pos.len()];
+    let vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
+    let mf = r.transform_mesh(&mesh, &cam.model_matrix(&torus::model(k)), &vp, &mut scratch)?;
+    let mut stats = Stats::default();
+    let mut y0 = 0u16;
+    while y0 < h {
+        let bh = band_h.min(h - y0);
+        let slice = &mut depth[y0 as usize * w as usize..(y0 + bh) as usize * w as usize];
+        let mut buf = DepthBuffer::band(slice, w, y0 as i32, bh)?;
+        buf.clear();
+        stats += r.draw_mesh_frame(&mut frame, &mut buf, &mf)?;
+        y0 += bh;
+    }
+    Ok((frame, depth, stats))
+}
