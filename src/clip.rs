@@ -154,7 +154,10 @@ impl Planes {
     /// Bit `p` set when `c` is outside plane `p`. A NaN distance (an overflow) counts as outside.
     #[inline]
     pub(crate) fn outcode(&self, c: &[f32; 4]) -> u8 {
-        (0..5).fold(0, |o, p| o | (u8::from(!(self.dist(p, c) >= 0.0)) << p))
+        (0..5).fold(0, |o, p| {
+            let d = self.dist(p, c);
+            o | (u8::from(d.is_nan() || d < 0.0) << p)
+        })
     }
 
     /// Screen `x, y`, the viewport's `z`, and `rhw` of a clip-space point inside every plane. The clip keeps the
@@ -256,7 +259,12 @@ pub(crate) fn fan<C>(
 
 impl<R: WSpan> Rasterizer<R> {
     /// Transforms, clips and maps a world-space triangle: the clipped polygon, empty when nothing is left.
-    fn clip_world(&self, m: &Mat4, vp: &Viewport, p: &[[f32; 3]; 3]) -> Result<(Planes, Poly), Error> {
+    fn clip_world(
+        &self,
+        m: &Mat4,
+        vp: &Viewport,
+        p: &[[f32; 3]; 3],
+    ) -> Result<(Planes, Poly), Error> {
         check_matrix(m)?;
         let planes = Planes::new(self.state.range.near(), vp)?;
         let c = [to_clip(m, &p[0])?, to_clip(m, &p[1])?, to_clip(m, &p[2])?];

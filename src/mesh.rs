@@ -134,15 +134,20 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
         mix: &impl Fn([C; 3], [f32; 3]) -> C,
         mut f: impl FnMut([Vertex<C>; 3]) -> Result<Stats, E>,
     ) -> Result<(), E> {
-        // Rows whose centre can be covered: y in [y0 + 0.5, y0 + h - 0.5]; a pixel of slack for the snap.
-        let (top, bottom) = (y0 as f32 - 1.0, (y0 + h as i32) as f32 + 1.0);
+        // Rows whose centre can be covered: y in [y0 + 0.5, y0 + h - 0.5]; a pixel of slack for the snap. Compared
+        // as ordered integers (`key`): a float compare is a library call on a core without an FPU.
+        let (top, bottom) = (key(y0 as f32 - 1.0), key((y0 + h as i32) as f32 + 1.0));
         for (k, tri) in self.mesh.indices.iter().enumerate() {
             let idx = tri.map(|i| i as usize);
             let [a, b, c] = idx.map(|i| self.verts[i]);
             let vc = self.colors(k, idx);
-            if a.rhw > 0.0 && b.rhw > 0.0 && c.rhw > 0.0 {
-                let (ymin, ymax) = (a.y.min(b.y).min(c.y), a.y.max(b.y).max(c.y));
-                if ymax < top || ymin > bottom {
+            // rhw > 0, as integers (positive floats have positive bit patterns; 0 marks a vertex to clip)
+            if (a.rhw.to_bits() as i32) > 0
+                && (b.rhw.to_bits() as i32) > 0
+                && (c.rhw.to_bits() as i32) > 0
+            {
+                let (ka, kb, kc) = (key(a.y), key(b.y), key(c.y));
+                if ka.max(kb).max(kc) < top || ka.min(kb).min(kc) > bottom {
                     continue;
                 }
                 let area = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
@@ -183,6 +188,13 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
         }
         Ok(())
     }
+}
+
+/// An integer with the order of the (non-NaN) f32 `y`: the bits, with the magnitude flipped for negative values.
+#[inline]
+fn key(y: f32) -> i32 {
+    let b = y.to_bits() as i32;
+    b ^ (((b >> 31) as u32) >> 1) as i32
 }
 
 /// Whether a triangle with screen area `area` (y down; positive = clockwise on the display) is culled. A zero or NaN

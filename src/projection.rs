@@ -40,16 +40,16 @@ impl Mat4 {
     }
 }
 
-/// `sin` and `cos` of `x` in f32, for `|x| <= 8192` (beyond, the argument reduction loses bits and the result is only
+/// `sin` and `cos` of `x` in f32, for `|x| <= 6000` (beyond, the argument reduction loses bits and the result is only
 /// bounded by 1): the argument is reduced by `pi/2` in three parts (Cody and Waite), then Taylor polynomials to `r^9`
 /// and `r^10` on `|r| <= pi/4` (truncation below `2e-9`). Error below `4e-7` absolute (five f32 roundings of terms
 /// at most 1, `5 * 2^-24 = 3e-7`, plus the truncation), checked against f64 in the tests. micromath's `sin`/`cos`
 /// document an error of 0.002: too coarse for a projection's planes or a rotation that a test compares with f64.
 pub fn sin_cos(x: f32) -> (f32, f32) {
-    // pi/2 = P1 + P2 + P3, P1 and P2 with 12 trailing zero bits so k * P1 and k * P2 are exact for k < 2^12.
-    const P1: f32 = 1.570_312_5;
-    const P2: f32 = 4.838_267_9e-4;
-    const P3: f32 = 6.077_100_5e-11;
+    // pi/2 = P1 + P2 + P3 (Cody and Waite), P1 and P2 short enough that k * P1 and k * P2 are exact for k < 2^12.
+    const P1: f32 = 1.570_312_5; // 0x3fc90000
+    const P2: f32 = f32::from_bits(0x39fd_a000); // 4.837513e-4
+    const P3: f32 = f32::from_bits(0x33a2_2169); // 7.54979e-8
     let k = {
         let q = x * core::f32::consts::FRAC_2_PI;
         // round half away from zero, without `f32::round` (std)
@@ -63,11 +63,11 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
     let kf = k as f32;
     let r = ((x - kf * P1) - kf * P2) - kf * P3;
     let r2 = r * r;
-    let s = r * (1.0 + r2 * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0 + r2 / 362_880.0))));
+    let s =
+        r * (1.0 + r2 * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0 + r2 / 362_880.0))));
     let c = 1.0
         + r2 * (-0.5
-            + r2 * (1.0 / 24.0
-                + r2 * (-1.0 / 720.0 + r2 * (1.0 / 40_320.0 - r2 / 3_628_800.0))));
+            + r2 * (1.0 / 24.0 + r2 * (-1.0 / 720.0 + r2 * (1.0 / 40_320.0 - r2 / 3_628_800.0))));
     match k & 3 {
         0 => (s, c),
         1 => (c, -s),
@@ -80,7 +80,7 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
 /// three Newton steps, each of which squares the relative error (`0.05 -> 1.3e-3 -> 7.8e-7 -> 3e-13`), so the
 /// result is within an f32 rounding or two. 0 for `x <= 0` or NaN.
 pub fn sqrt(x: f32) -> f32 {
-    if !(x > 0.0) {
+    if x.is_nan() || x <= 0.0 {
         return 0.0;
     }
     let mut y = micromath::F32(x).sqrt().0;
@@ -416,7 +416,7 @@ mod tests {
     #[test]
     fn w_friendly_perspective() {
         for (fov, a, n, f) in [
-            (1.047_197_6f32, 4.0 / 3.0, 0.5f32, 100.0f32),
+            (core::f32::consts::FRAC_PI_3, 4.0 / 3.0, 0.5f32, 100.0f32),
             (1.5, 1.0, 10.0, 1000.0),
             (0.3, 2.0, 0.1, 50.0),
         ] {
@@ -430,14 +430,24 @@ mod tests {
             // a point on the top edge of the field of view at depth 7 lands on y/w = 1, on the right edge x/w = 1
             let t = (fov as f64 / 2.0).tan();
             let top = p.matrix.transform([0.0, (7.0 * t) as f32, 7.0, 1.0]);
-            let right = p.matrix.transform([(7.0 * t * a as f64) as f32, 0.0, 7.0, 1.0]);
+            let right = p
+                .matrix
+                .transform([(7.0 * t * a as f64) as f32, 0.0, 7.0, 1.0]);
             assert_eq!(top[3], 7.0);
-            assert!((top[1] / top[3] - 1.0).abs() < 2e-6 && (right[0] / right[3] - 1.0).abs() < 2e-6);
+            assert!(
+                (top[1] / top[3] - 1.0).abs() < 2e-6 && (right[0] / right[3] - 1.0).abs() < 2e-6
+            );
         }
         assert_eq!(perspective(60.0, 1.0, 1.0, 10.0), Err(Error::InvalidCamera));
         assert_eq!(perspective(1.0, 0.0, 1.0, 10.0), Err(Error::InvalidCamera));
-        assert_eq!(perspective(1.0, 1.0, 10.0, 1.0), Err(Error::InvalidDepthRange));
-        assert_eq!(perspective(1.0, f32::INFINITY, 1.0, 10.0), Err(Error::NonFinite));
+        assert_eq!(
+            perspective(1.0, 1.0, 10.0, 1.0),
+            Err(Error::InvalidDepthRange)
+        );
+        assert_eq!(
+            perspective(1.0, f32::INFINITY, 1.0, 10.0),
+            Err(Error::NonFinite)
+        );
     }
 
     /// look_at: the eye maps to the origin, the target to `(0, 0, distance)`, `up` to `+y`; rotations are
@@ -462,13 +472,30 @@ mod tests {
         );
         let q = core::f32::consts::FRAC_PI_2;
         let close3 = |a: [f32; 4], b: [f32; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-6);
-        assert!(close3(Mat4::rotation_z(q).transform([1.0, 0.0, 0.0, 1.0]), [0.0, 1.0, 0.0, 1.0]));
-        assert!(close3(Mat4::rotation_x(q).transform([0.0, 1.0, 0.0, 1.0]), [0.0, 0.0, 1.0, 1.0]));
-        assert!(close3(Mat4::rotation_y(q).transform([0.0, 0.0, 1.0, 1.0]), [1.0, 0.0, 0.0, 1.0]));
+        assert!(close3(
+            Mat4::rotation_z(q).transform([1.0, 0.0, 0.0, 1.0]),
+            [0.0, 1.0, 0.0, 1.0]
+        ));
+        assert!(close3(
+            Mat4::rotation_x(q).transform([0.0, 1.0, 0.0, 1.0]),
+            [0.0, 0.0, 1.0, 1.0]
+        ));
+        assert!(close3(
+            Mat4::rotation_y(q).transform([0.0, 0.0, 1.0, 1.0]),
+            [1.0, 0.0, 0.0, 1.0]
+        ));
         let m = Mat4::scale([2.0, 3.0, 4.0]) * Mat4::translation([1.0, 1.0, 1.0]);
         assert_eq!(m.transform([1.0, 1.0, 1.0, 1.0]), [3.0, 4.0, 5.0, 1.0]);
-        let c = Camera::look_at([0.0, 0.0, 3.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 0.5, 100.0)
-            .unwrap();
+        let c = Camera::look_at(
+            [0.0, 0.0, 3.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            1.0,
+            1.0,
+            0.5,
+            100.0,
+        )
+        .unwrap();
         assert_eq!(c.matrix().transform([0.0, 0.0, 1.0, 1.0])[3], 2.0);
         assert_eq!(c.render_state().unwrap().cull, crate::Cull::Cw);
     }
@@ -507,15 +534,21 @@ mod tests {
         assert_eq!(w_planes(&Mat4::IDENTITY), Err(Error::InvalidDepthRange));
     }
 
-    /// `sin_cos` within its documented 4e-7 of f64 over `[-100, 100]`.
+    /// `sin_cos` within its documented 4e-7 of f64 over `[-100, 100]` densely and `[-6000, 6000]` sparsely.
     #[test]
     fn f32_sin_cos() {
         let mut worst = 0.0f64;
-        for k in 0..=200_000 {
-            let x = -100.0f32 + k as f32 * 0.001;
+        for k in 0..=400_000 {
+            let x = if k <= 200_000 {
+                -100.0f32 + k as f32 * 0.001
+            } else {
+                -6000.0 + (k - 200_000) as f32 * 0.06
+            };
             let (s, c) = sin_cos(x);
             let xd = x as f64;
-            worst = worst.max((s as f64 - xd.sin()).abs()).max((c as f64 - xd.cos()).abs());
+            worst = worst
+                .max((s as f64 - xd.sin()).abs())
+                .max((c as f64 - xd.cos()).abs());
         }
         std::println!("sin_cos worst {worst:e} (bound 4e-7)");
         assert!(worst < 4e-7, "{worst}");

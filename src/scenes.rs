@@ -338,9 +338,7 @@ pub mod torus {
         core::array::from_fn(|k| {
             let (q, second) = (k / 2, k % 2 == 1);
             let (i, j) = (q % SEG_I, q / SEG_I);
-            let v = |di: usize, dj: usize| {
-                (((j + dj) % SEG_J) * SEG_I + (i + di) % SEG_I) as u16
-            };
+            let v = |di: usize, dj: usize| (((j + dj) % SEG_J) * SEG_I + (i + di) % SEG_I) as u16;
             if second {
                 [v(0, 0), v(1, 1), v(0, 1)]
             } else {

@@ -429,14 +429,21 @@ pub fn hash_frame(hash: &mut u64, frame: &Frame, depth: &[u16]) {
     };
     let w = frame.w as usize;
     for row in 0..frame.h as usize {
-        words(&mut frame.px[row * w..(row + 1) * w].iter().map(|c| c.into_storage()));
+        words(
+            &mut frame.px[row * w..(row + 1) * w]
+                .iter()
+                .map(|c| c.into_storage()),
+        );
         words(&mut depth[row * w..(row + 1) * w].iter().copied());
     }
 }
 
 /// W4 frame `k` (`wraster::scenes::torus`) through the mesh path, transformed once and drawn in bands of `band_h`
 /// rows (the last may be shorter), each band's depth cleared first: the frame, its depth, the summed stats.
-pub fn render_torus<R: SpanRecip>(k: usize, band_h: u16) -> Result<(Frame, Vec<u16>, Stats), Error> {
+pub fn render_torus<R: SpanRecip>(
+    k: usize,
+    band_h: u16,
+) -> Result<(Frame, Vec<u16>, Stats), Error> {
     use wraster::clip::Viewport;
     use wraster::mesh::{Colors, Mesh, Projected};
     use wraster::scenes::{torus, HEIGHT, WIDTH};
@@ -453,7 +460,12 @@ pub fn render_torus<R: SpanRecip>(k: usize, band_h: u16) -> Result<(Frame, Vec<u
     let mut r = Rasterizer::<R>::new(cam.render_state()?);
     let mut scratch = vec![Projected::default(); pos.len()];
     let vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
-    let mf = r.transform_mesh(&mesh, &cam.model_matrix(&torus::model(k)), &vp, &mut scratch)?;
+    let mf = r.transform_mesh(
+        &mesh,
+        &cam.model_matrix(&torus::model(k)),
+        &vp,
+        &mut scratch,
+    )?;
     let mut stats = Stats::default();
     let mut y0 = 0u16;
     while y0 < h {

@@ -3,27 +3,19 @@
 //! Each QEMU board (boards/qemu-*) prints one `bench` line per scene and reciprocal strategy with a hash of its final
 //! frame: FNV-1a 64 over the rows in order, each row's RGB565 colours (u16 little-endian) then its W16 depths (u16
 //! little-endian). This test renders the same scenes here, whole-frame (the M0 board renders in 30 bands), hashes
-//! them with its own FNV-1a, and asserts every board's hash and pixel counts equal the host's.
+//! them with its own FNV-1a, and asserts every board's hash and pixel counts equal the host's. W4 (the torus, 8
+//! frames through the mesh path) has one hash over its 8 frames; the M0 runs it in a build of its own
+//! (`--features torus`).
 //!
 //! The boards run under QEMU when it is installed; `.ci/run` installs it and sets `CI=true`, which makes QEMU
 //! required (a missing emulator fails the test instead of skipping it).
 
 use std::collections::HashMap;
 
-use embedded_graphics::pixelcolor::IntoStorage;
-use host_tests::{have, render, run_board};
+use host_tests::{hash_frame, have, render, render_torus, run_board};
 use wraster::recip::{Exact, Fast, PrevPixel, SpanRecip};
-use wraster::scenes::{Scene, HEIGHT, WIDTH};
+use wraster::scenes::{torus, Scene, HEIGHT, WIDTH};
 use wraster::RenderState;
-
-fn fnv1a(hash: &mut u64, words: impl IntoIterator<Item = u16>) {
-    for w in words {
-        for b in w.to_le_bytes() {
-            *hash ^= b as u64;
-            *hash = hash.wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    }
-}
 
 /// `(scene, recip) -> (hash, written, fragments)` on the host.
 fn host_runs<R: SpanRecip>(out: &mut HashMap<(String, String), (u64, u32, u32)>) {
@@ -38,22 +30,22 @@ fn host_runs<R: SpanRecip>(out: &mut HashMap<(String, String), (u64, u32, u32)>)
             HEIGHT,
         )
         .unwrap();
-        let w = WIDTH as usize;
         let mut h = 0xcbf2_9ce4_8422_2325u64;
-        for row in 0..HEIGHT as usize {
-            fnv1a(
-                &mut h,
-                frame.px[row * w..(row + 1) * w]
-                    .iter()
-                    .map(|c| c.into_storage()),
-            );
-            fnv1a(&mut h, depth[row * w..(row + 1) * w].iter().copied());
-        }
+        hash_frame(&mut h, &frame, &depth);
         out.insert(
             (scene.name().into(), R::NAME.into()),
             (h, stats.written, stats.fragments),
         );
     }
+    // W4: the 8 torus frames through the mesh path, one hash over all of them in order.
+    let (mut h, mut written, mut fragments) = (0xcbf2_9ce4_8422_2325u64, 0, 0);
+    for k in 0..torus::FRAMES {
+        let (frame, depth, stats) = render_torus::<R>(k, HEIGHT).unwrap();
+        hash_frame(&mut h, &frame, &depth);
+        written += stats.written;
+        fragments += stats.fragments;
+    }
+    out.insert(("torus".into(), R::NAME.into()), (h, written, fragments));
 }
 
 #[test]
@@ -77,8 +69,15 @@ fn boards_render_the_hosts_frames_bit_for_bit() {
     host_runs::<Exact>(&mut host);
     host_runs::<PrevPixel>(&mut host);
 
-    for (board, bands) in [("qemu-m4", 1), ("qemu-m0", 30), ("qemu-rv32", 1)] {
-        let stdout = run_board(board, &[]).unwrap_or_else(|e| panic!("{e}"));
+    // The M0's 16 KiB hold the standard scenes (30 bands) or W4 (60 bands: its vertex store takes 6 KiB), one build
+    // each.
+    for (board, features, bands, lines) in [
+        ("qemu-m4", &[][..], 1, host.len()),
+        ("qemu-m0", &[][..], 30, host.len() - 3),
+        ("qemu-m0", &["torus"][..], 60, 3),
+        ("qemu-rv32", &[][..], 1, host.len()),
+    ] {
+        let stdout = run_board(board, features).unwrap_or_else(|e| panic!("{e}"));
         let mut seen = 0;
         for line in stdout.lines().filter(|l| l.starts_with("bench ")) {
             let key = (
@@ -111,9 +110,8 @@ fn boards_render_the_hosts_frames_bit_for_bit() {
             seen += 1;
         }
         assert_eq!(
-            seen,
-            host.len(),
-            "{board} printed {seen} bench lines:\n{stdout}"
+            seen, lines,
+            "{board} {features:?} printed {seen} bench lines:\n{stdout}"
         );
     }
 }

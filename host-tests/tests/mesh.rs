@@ -83,10 +83,18 @@ impl Reference {
         for (id, t) in tris.iter().enumerate() {
             let sx = t.map(|v| 160.0 + 160.0 * v[0] / (v[2] * tan * 4.0 / 3.0));
             let sy = t.map(|v| 120.0 - 120.0 * v[1] / (v[2] * tan));
-            let x0 = (sx.iter().cloned().fold(f64::MAX, f64::min) - 1.5).floor().max(0.0) as usize;
-            let x1 = (sx.iter().cloned().fold(f64::MIN, f64::max) + 1.5).ceil().min(w as f64) as usize;
-            let y0 = (sy.iter().cloned().fold(f64::MAX, f64::min) - 1.5).floor().max(0.0) as usize;
-            let y1 = (sy.iter().cloned().fold(f64::MIN, f64::max) + 1.5).ceil().min(h as f64) as usize;
+            let x0 = (sx.iter().cloned().fold(f64::MAX, f64::min) - 1.5)
+                .floor()
+                .max(0.0) as usize;
+            let x1 = (sx.iter().cloned().fold(f64::MIN, f64::max) + 1.5)
+                .ceil()
+                .min(w as f64) as usize;
+            let y0 = (sy.iter().cloned().fold(f64::MAX, f64::min) - 1.5)
+                .floor()
+                .max(0.0) as usize;
+            let y1 = (sy.iter().cloned().fold(f64::MIN, f64::max) + 1.5)
+                .ceil()
+                .min(h as f64) as usize;
             for y in y0..y1 {
                 for x in x0..x1 {
                     bins[y * w + x].push(id as u32);
@@ -127,13 +135,21 @@ fn check_frames<R: SpanRecip>() {
             for px in 0..w {
                 let pix = py * w + px;
                 let (cx, cy) = (px as f64 + 0.5, py as f64 + 0.5);
-                let probes: Vec<Option<(u32, f64)>> =
-                    [(0.0, 0.0), (0.75, 0.0), (-0.75, 0.0), (0.0, 0.75), (0.0, -0.75)]
-                        .iter()
-                        .map(|(dx, dy)| rf.nearest(pix, cx + dx, cy + dy))
-                        .collect();
+                let probes: Vec<Option<(u32, f64)>> = [
+                    (0.0, 0.0),
+                    (0.75, 0.0),
+                    (-0.75, 0.0),
+                    (0.0, 0.75),
+                    (0.0, -0.75),
+                ]
+                .iter()
+                .map(|(dx, dy)| rf.nearest(pix, cx + dx, cy + dy))
+                .collect();
                 if probes.iter().all(|p| p.is_none()) {
-                    assert_eq!(frame.writes[pix], 0, "frame {k} ({px},{py}) should be empty");
+                    assert_eq!(
+                        frame.writes[pix], 0,
+                        "frame {k} ({px},{py}) should be empty"
+                    );
                     assert_eq!(depth[pix], W16_FAR);
                     empty += 1;
                     continue;
@@ -147,18 +163,29 @@ fn check_frames<R: SpanRecip>() {
                     .map(|p| (code(p.unwrap().1) - code(z)).abs())
                     .fold(0.0, f64::max);
                 let bound = 1.0 + grad / 128.0;
-                assert!(frame.writes[pix] > 0, "frame {k} ({px},{py}) should be covered");
+                assert!(
+                    frame.writes[pix] > 0,
+                    "frame {k} ({px},{py}) should be covered"
+                );
                 assert_eq!(
                     frame.px[pix], colors[id as usize],
                     "frame {k} ({px},{py}): the visible triangle is {id}"
                 );
                 let err = (depth[pix] as f64 - code(z)).abs();
-                assert!(err <= bound, "frame {k} ({px},{py}): {} vs {} (bound {bound})", depth[pix], code(z));
+                assert!(
+                    err <= bound,
+                    "frame {k} ({px},{py}): {} vs {} (bound {bound})",
+                    depth[pix],
+                    code(z)
+                );
                 over1 += usize::from(err > 1.0);
                 compared += 1;
             }
         }
-        assert!(stats.culled > 400, "frame {k}: about half the torus faces away: {stats:?}");
+        assert!(
+            stats.culled > 400,
+            "frame {k}: about half the torus faces away: {stats:?}"
+        );
     }
     println!(
         "{}: {compared} covered pixels compared, {over1} over 1 code (within the snap term), {empty} empty",
@@ -184,7 +211,10 @@ fn bands_equal_the_whole_frame() {
         let whole = render_torus::<Fast>(k, HEIGHT).unwrap();
         for band in [1, 7, 8, 64] {
             let banded = render_torus::<Fast>(k, band).unwrap();
-            assert!(whole.0 == banded.0 && whole.1 == banded.1, "frame {k}, bands of {band}");
+            assert!(
+                whole.0 == banded.0 && whole.1 == banded.1,
+                "frame {k}, bands of {band}"
+            );
             assert_eq!(whole.2.written, banded.2.written);
         }
         let (mut a, mut b) = (0u64, 0u64);
@@ -229,7 +259,16 @@ fn cube() -> ([[f32; 3]; 8], [[u16; 3]; 12]) {
 #[test]
 fn bad_meshes_are_errors_and_write_nothing() {
     let (pos, idx) = cube();
-    let cam = Camera::look_at([3.0, 2.0, 5.0], [0.0; 3], [0.0, 1.0, 0.0], 1.0, 1.0, 0.5, 50.0).unwrap();
+    let cam = Camera::look_at(
+        [3.0, 2.0, 5.0],
+        [0.0; 3],
+        [0.0, 1.0, 0.0],
+        1.0,
+        1.0,
+        0.5,
+        50.0,
+    )
+    .unwrap();
     let vp = Viewport::new(0.0, 0.0, 48.0, 48.0);
     let mut frame = Frame::new(48, 48);
     let mut depth = vec![0u16; 48 * 48];
@@ -244,33 +283,66 @@ fn bad_meshes_are_errors_and_write_nothing() {
     let faces = [Rgb565::RED; 11];
     let cases: [(Mesh<Rgb565>, Mat4, Error); 4] = [
         (
-            Mesh { positions: &pos, indices: &bad_idx, colors: Colors::Uniform(Rgb565::RED) },
+            Mesh {
+                positions: &pos,
+                indices: &bad_idx,
+                colors: Colors::Uniform(Rgb565::RED),
+            },
             cam.matrix(),
             Error::IndexOutOfRange,
         ),
         (
-            Mesh { positions: &pos, indices: &idx, colors: Colors::PerFace(&faces) },
+            Mesh {
+                positions: &pos,
+                indices: &idx,
+                colors: Colors::PerFace(&faces),
+            },
             cam.matrix(),
             Error::IndexOutOfRange,
         ),
         (
-            Mesh { positions: &nan_pos, indices: &idx, colors: Colors::Uniform(Rgb565::RED) },
+            Mesh {
+                positions: &nan_pos,
+                indices: &idx,
+                colors: Colors::Uniform(Rgb565::RED),
+            },
             cam.matrix(),
             Error::NonFinite,
         ),
         (
-            Mesh { positions: &pos, indices: &idx, colors: Colors::Uniform(Rgb565::RED) },
+            Mesh {
+                positions: &pos,
+                indices: &idx,
+                colors: Colors::Uniform(Rgb565::RED),
+            },
             Mat4([[f32::NAN; 4]; 4]),
             Error::NonFinite,
         ),
     ];
     for (mesh, m, e) in cases {
-        assert_eq!(r.draw_mesh(&mut frame, &mut buf, &mesh, &m, &vp, &mut scratch), Err(e));
+        assert_eq!(
+            r.draw_mesh(&mut frame, &mut buf, &mesh, &m, &vp, &mut scratch),
+            Err(e)
+        );
     }
-    let ok = Mesh { positions: &pos, indices: &idx, colors: Colors::Uniform(Rgb565::RED) };
+    let ok = Mesh {
+        positions: &pos,
+        indices: &idx,
+        colors: Colors::Uniform(Rgb565::RED),
+    };
     assert_eq!(
-        r.draw_mesh(&mut frame, &mut buf, &ok, &cam.matrix(), &vp, &mut scratch[..7]),
-        Err(Error::BufferSize { expected: 8, actual: 7 })
+        r.draw_mesh(
+            &mut frame,
+            &mut buf,
+            &ok,
+            &cam.matrix(),
+            &vp,
+            &mut scratch[..7]
+        ),
+        Err(Error::BufferSize {
+            expected: 8,
+            actual: 7
+        })
     );
     assert!(frame.writes.iter().all(|&n| n == 0));
     assert!(depth.iter().all(|&d| d == W16_FAR));
@@ -285,8 +357,16 @@ fn a_closed_cube_writes_each_pixel_once_and_draws_from_inside() {
     let (pos, idx) = cube();
     let vp = Viewport::new(0.0, 0.0, 64.0, 48.0);
     for eye in [[3.0, 2.0, 5.0], [-4.0, -3.0, 2.5], [0.2, 0.1, 0.3]] {
-        let cam =
-            Camera::look_at(eye, [0.0, 0.0, 0.0], [0.0, 1.0, 0.0], 1.2, 64.0 / 48.0, 0.1, 50.0).unwrap();
+        let cam = Camera::look_at(
+            eye,
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            1.2,
+            64.0 / 48.0,
+            0.1,
+            50.0,
+        )
+        .unwrap();
         let inside = eye.iter().all(|c| c.abs() < 1.0);
         let mut state = cam.render_state().unwrap();
         state.mode = wraster::DepthMode::Off;
@@ -299,11 +379,25 @@ fn a_closed_cube_writes_each_pixel_once_and_draws_from_inside() {
         let mut buf = DepthBuffer::new(&mut depth, 64, 48).unwrap();
         buf.clear();
         let mut scratch = [Projected::default(); 8];
-        let mesh = Mesh { positions: &pos, indices: &idx, colors: Colors::Uniform(Rgb565::WHITE) };
+        let mesh = Mesh {
+            positions: &pos,
+            indices: &idx,
+            colors: Colors::Uniform(Rgb565::WHITE),
+        };
         let stats = r
-            .draw_mesh(&mut frame, &mut buf, &mesh, &cam.matrix(), &vp, &mut scratch)
+            .draw_mesh(
+                &mut frame,
+                &mut buf,
+                &mesh,
+                &cam.matrix(),
+                &vp,
+                &mut scratch,
+            )
             .unwrap();
-        assert!(frame.writes.iter().all(|&n| n <= 1), "eye {eye:?}: a pixel written twice");
+        assert!(
+            frame.writes.iter().all(|&n| n <= 1),
+            "eye {eye:?}: a pixel written twice"
+        );
         let covered = frame.writes.iter().filter(|&&n| n == 1).count();
         if inside {
             assert_eq!(covered, 64 * 48, "eye {eye:?}: {stats:?}");
@@ -318,7 +412,16 @@ fn a_closed_cube_writes_each_pixel_once_and_draws_from_inside() {
 /// vertex beyond f32 is `WorldTooLarge`, with nothing written.
 #[test]
 fn huge_world_triangles_draw_or_say_what_was_too_large() {
-    let cam = Camera::look_at([0.0, 1.0, 0.0], [0.0, 1.0, -1.0], [0.0, 1.0, 0.0], 1.2, 1.0, 0.5, 1000.0).unwrap();
+    let cam = Camera::look_at(
+        [0.0, 1.0, 0.0],
+        [0.0, 1.0, -1.0],
+        [0.0, 1.0, 0.0],
+        1.2,
+        1.0,
+        0.5,
+        1000.0,
+    )
+    .unwrap();
     let vp = Viewport::new(0.0, 0.0, 48.0, 48.0);
     for far in [1e3f32, 1e16, 1e30] {
         let t = [[-far, 0.0, 0.5], [far, 0.0, 0.5], [0.0, 0.0, -far]];
@@ -332,8 +435,14 @@ fn huge_world_triangles_draw_or_say_what_was_too_large() {
             .unwrap_or_else(|e| panic!("{far}: {e}"));
         // the ground fills the lower half of the view (below the horizon at row 24), up to the far plane
         let lower: usize = frame.writes[25 * 48..].iter().filter(|&&n| n > 0).count();
-        assert!(lower > 20 * 48, "{far}: {lower} pixels below the horizon, {stats:?}");
-        assert!(frame.writes[..23 * 48].iter().all(|&n| n == 0), "{far}: nothing above the horizon");
+        assert!(
+            lower > 20 * 48,
+            "{far}: {lower} pixels below the horizon, {stats:?}"
+        );
+        assert!(
+            frame.writes[..23 * 48].iter().all(|&n| n == 0),
+            "{far}: nothing above the horizon"
+        );
     }
     let t = [[-1.0, 0.0, -5.0], [1.0, 0.0, -5.0], [0.0, 3e38, -5.0]];
     let mut frame = Frame::new(48, 48);

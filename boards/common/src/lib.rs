@@ -1,5 +1,6 @@
 //! What every wraster firmware shares: the standard scenes baked into flash (from `wraster::scenes`, by build.rs),
-//! rendering them band by band with triangles binned by rows, the frame hash, and the `bench` line.
+//! rendering them band by band with triangles binned by rows, W4's torus through the mesh path, the frame hash, and
+//! the `bench` line.
 //!
 //! Hash: FNV-1a 64 over the frame's rows in order; for each row the colour of every pixel (RGB565, u16 little-endian)
 //! then the depth of every pixel (W16, u16 little-endian). The host computes the same (host-tests/tests/firmware.rs).
@@ -14,6 +15,8 @@ use embedded_graphics_core::pixelcolor::raw::RawU16;
 use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
+use wraster::clip::Viewport;
+use wraster::mesh::{Colors, Mesh, Projected};
 use wraster::recip::SpanRecip;
 use wraster::{DepthBuffer, Error, Rasterizer, RenderState, Stats, Vertex};
 
@@ -303,6 +306,122 @@ pub fn run_all<R: SpanRecip, C: Counter>(
     ok
 }
 
+/// W4 "torus" (`wraster::scenes::torus`): 8 frames of the rotating mesh, each transformed once
+/// ([`Rasterizer::transform_mesh`] into `verts`, at least 512) and drawn band by band
+/// ([`Rasterizer::draw_mesh_frame`]) with the given buffers, depth cleared per band. Counts the transform and the
+/// draws (not the clears or the hash); the hash runs over the 8 frames in order.
+pub fn run_torus<R: SpanRecip, C: Counter>(
+    color: &mut [u16],
+    depth: &mut [u16],
+    verts: &mut [Projected],
+    counter: &mut C,
+) -> Result<Run, Error> {
+    run_torus_with::<R, C>(
+        color,
+        depth,
+        verts,
+        counter,
+        0..wraster::scenes::torus::FRAMES,
+        |_, _| {},
+    )
+}
+
+/// [`run_torus`] for frames `frames` (frame `k` rotates by `k` steps; any `k`), handing each finished band (first
+/// row, RGB565 pixels) to `on_band`, as a display driver wants it.
+pub fn run_torus_with<R: SpanRecip, C: Counter>(
+    color: &mut [u16],
+    depth: &mut [u16],
+    verts: &mut [Projected],
+    counter: &mut C,
+    frames: core::ops::Range<usize>,
+    mut on_band: impl FnMut(u16, &[u16]),
+) -> Result<Run, Error> {
+    use wraster::scenes::torus;
+    let band_h = (depth.len() / WIDTH as usize) as u16;
+    let cam = torus::camera()?;
+    let mut r = Rasterizer::<R>::new(cam.render_state()?);
+    let mesh = Mesh {
+        positions: &TORUS_POSITIONS,
+        indices: &TORUS_INDICES,
+        colors: Colors::PerFace(&TORUS_COLORS),
+    };
+    let vp = Viewport::new(0.0, 0.0, WIDTH as f32, HEIGHT as f32);
+    let mut stats = Stats::default();
+    let (mut instructions, mut hash, mut bands) = (0u64, Fnv::default(), 0u32);
+    let n_frames = frames.len() as u32;
+    for k in frames {
+        let m = cam.model_matrix(&torus::model(k));
+        counter.start();
+        let frame = r.transform_mesh(&mesh, &m, &vp, verts);
+        instructions += counter.stop();
+        let frame = frame?;
+        let mut y0 = 0u16;
+        while y0 < HEIGHT {
+            let h = band_h.min(HEIGHT - y0);
+            let n = WIDTH as usize * h as usize;
+            let (color, depth) = (&mut color[..n], &mut depth[..n]);
+            color.fill(0);
+            let mut buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+            buf.clear();
+            let mut band = Band::new(color, y0 as i32);
+            counter.start();
+            let s = r.draw_mesh_frame(&mut band, &mut buf, &frame);
+            instructions += counter.stop();
+            stats += s?;
+            let w = WIDTH as usize;
+            for row in 0..h as usize {
+                hash.words(&band.px[row * w..(row + 1) * w]);
+                hash.words(&buf.data()[row * w..(row + 1) * w]);
+            }
+            on_band(y0, band.px);
+            bands += 1;
+            y0 += h;
+        }
+    }
+    Ok(Run {
+        scene: "torus",
+        recip: R::NAME,
+        stats,
+        bands: bands / n_frames.max(1),
+        triangles: torus::TRIANGLES as u32 * n_frames,
+        instructions,
+        hash: hash.0,
+    })
+}
+
+/// [`run_torus`] and its `bench` line (with `frames=8 instr_per_frame=`) or an `error` line; `false` on an error.
+/// Skipped (true) when the build-time `ONLY` names another scene.
+pub fn run_torus_line<R: SpanRecip, C: Counter>(
+    board: &str,
+    core: &str,
+    color: &mut [u16],
+    depth: &mut [u16],
+    verts: &mut [Projected],
+    counter: &mut C,
+    mut print: impl FnMut(core::fmt::Arguments<'_>),
+) -> bool {
+    if option_env!("ONLY").is_some_and(|o| o != "torus") {
+        return true;
+    }
+    match run_torus::<R, C>(color, depth, verts, counter) {
+        Ok(run) => {
+            let mut line = bench_line(board, core, &run);
+            let frames = wraster::scenes::torus::FRAMES as u64;
+            let _ = write!(
+                line,
+                " frames={frames} instr_per_frame={}",
+                Ratio(run.instructions, frames)
+            );
+            print(format_args!("{line}"));
+            true
+        }
+        Err(e) => {
+            print(format_args!("error board={board} scene=torus {e}"));
+            false
+        }
+    }
+}
+
 /// `num / den` with one decimal, by integers.
 struct Ratio(u64, u64);
 
@@ -314,7 +433,7 @@ impl core::fmt::Display for Ratio {
 }
 
 /// The bench line of a run (the format; keys are stable).
-pub fn bench_line(board: &str, core: &str, run: &Run) -> heapless::String<320> {
+pub fn bench_line(board: &str, core: &str, run: &Run) -> heapless::String<360> {
     let mut s = heapless::String::new();
     let (px, fr) = (run.stats.written as u64, run.stats.fragments as u64);
     let _ = write!(

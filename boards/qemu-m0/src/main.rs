@@ -2,7 +2,8 @@
 //!
 //! The frame does not fit in RAM: every standard scene is rendered in 30 bands of 8 rows (a 320x8 colour band and
 //! a 320x8 W16 band, 10 KiB), triangles binned by rows (see `wraster-board`), with the default reciprocal and with the previous-pixel seed, prints one `bench` line per
-//! run over semihosting and exits 0; any error or panic exits non-zero.
+//! run over semihosting and exits 0; any error or panic exits non-zero. `--features torus` builds W4 instead (the
+//! rotating torus through the mesh path, 60 bands of 4 rows: its 512 transformed vertices take 6 KiB of the 16).
 //! Run: `cd boards/qemu-m0 && cargo run --release` (the runner in `.cargo/config.toml` adds `-icount shift=0`).
 //!
 //! Instructions are counted with SysTick on the 16 MHz core clock: one tick is exactly 62.5 instructions under
@@ -14,18 +15,29 @@
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use panic_semihosting as _;
-#[cfg(not(feature = "size-probe"))]
+use wraster::recip::Fast;
+#[cfg(not(feature = "torus"))]
+use wraster::recip::SpanRecip;
+#[cfg(any(not(feature = "size-probe"), feature = "torus"))]
 use wraster::recip::{Exact, PrevPixel};
-use wraster::recip::{Fast, SpanRecip};
-use wraster_board::{run_all, SysTick, HEIGHT, WIDTH};
-#[cfg(not(feature = "size-probe"))]
+#[cfg(not(feature = "torus"))]
+use wraster_board::run_all;
+#[cfg(not(any(feature = "size-probe", feature = "torus")))]
 use wraster_board::{run_scene, SCENES};
+use wraster_board::{SysTick, HEIGHT, WIDTH};
+#[cfg(feature = "torus")]
+use {wraster::mesh::Projected, wraster::scenes::torus::VERTICES};
 
 /// Rows per band: the largest multiple of 8 whose two buffers leave room for the stack in 16 KiB.
+#[cfg(not(feature = "torus"))]
 const BAND_ROWS: usize = 8;
+/// With `--features torus` the 512 transformed vertices take 6 KiB, so the bands are 4 rows (60 bands, 5 KiB).
+#[cfg(feature = "torus")]
+const BAND_ROWS: usize = 4;
 const PIXELS: usize = WIDTH as usize * BAND_ROWS;
 const _: () = assert!((HEIGHT as usize).is_multiple_of(BAND_ROWS));
 
+#[cfg(not(feature = "torus"))]
 fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
     run_all::<R, _>("qemu-m0", "m0", color, depth, counter, |line| {
         hprintln!("{}", line)
@@ -35,7 +47,7 @@ fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick
 /// The cost of banding, measured on this core: every scene drawn again in 60 bands of 4 rows; the extra
 /// instructions over the 30-band run, divided by the 30 extra bands, are what one band costs (triangle setup
 /// repeated for triangles spanning both halves, the span walk restarted, the binning test).
-#[cfg(not(feature = "size-probe"))]
+#[cfg(not(any(feature = "size-probe", feature = "torus")))]
 fn band_overhead(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
     let half = WIDTH as usize * BAND_ROWS / 2;
     for scene in &SCENES {
@@ -60,6 +72,49 @@ fn band_overhead(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) ->
     true
 }
 
+/// `--features torus`: W4 only (the rotating torus through the mesh path), with each strategy.
+#[cfg(feature = "torus")]
+#[entry]
+fn main() -> ! {
+    static mut COLOR: [u16; PIXELS] = [0; PIXELS];
+    static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
+    static mut VERTS: [Projected; VERTICES] = [Projected {
+        x: 0.0,
+        y: 0.0,
+        rhw: 0.0,
+    }; VERTICES];
+    let cp = cortex_m::Peripherals::take().unwrap();
+    let mut counter = SysTick::new(cp.SYST, 125, 2);
+    fn torus<R: wraster::recip::SpanRecip>(
+        color: &mut [u16],
+        depth: &mut [u16],
+        verts: &mut [Projected],
+        counter: &mut SysTick,
+    ) -> bool {
+        wraster_board::run_torus_line::<R, _>(
+            "qemu-m0",
+            "m0",
+            color,
+            depth,
+            verts,
+            counter,
+            |line| hprintln!("{}", line),
+        )
+    }
+    let ok = torus::<Fast>(COLOR, DEPTH, VERTS, &mut counter)
+        & torus::<Exact>(COLOR, DEPTH, VERTS, &mut counter)
+        & torus::<PrevPixel>(COLOR, DEPTH, VERTS, &mut counter);
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+#[cfg(not(feature = "torus"))]
 #[entry]
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];

@@ -1,6 +1,6 @@
 //! wraster on QEMU `mps2-an386` (Cortex-M4F, thumbv7em-none-eabihf), memory map from the top-level `memory.x`.
 //!
-//! Renders every standard scene (`wraster::scenes`, baked by `wraster-board`) whole-frame (320x240 colour and W16
+//! Renders every standard scene and W4's torus (`wraster::scenes`, baked by `wraster-board`) whole-frame (320x240 colour and W16
 //! depth in RAM, one band), with the default reciprocal and with the previous-pixel seed, prints one `bench` line per
 //! run over semihosting and exits 0; any error or panic exits non-zero.
 //! Run: `cd boards/qemu-m4 && cargo run --release` (the runner in `.cargo/config.toml` adds `-icount shift=0`).
@@ -14,15 +14,24 @@
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use panic_semihosting as _;
+use wraster::mesh::Projected;
 #[cfg(not(feature = "size-probe"))]
 use wraster::recip::{Exact, PrevPixel};
 use wraster::recip::{Fast, SpanRecip};
-use wraster_board::{run_all, SysTick, HEIGHT, WIDTH};
+use wraster::scenes::torus::VERTICES;
+use wraster_board::{run_all, run_torus_line, SysTick, HEIGHT, WIDTH};
 
 const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
 
-fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
+fn all<R: SpanRecip>(
+    color: &mut [u16],
+    depth: &mut [u16],
+    verts: &mut [Projected],
+    counter: &mut SysTick,
+) -> bool {
     run_all::<R, _>("qemu-m4", "m4", color, depth, counter, |line| {
+        hprintln!("{}", line)
+    }) & run_torus_line::<R, _>("qemu-m4", "m4", color, depth, verts, counter, |line| {
         hprintln!("{}", line)
     })
 }
@@ -31,18 +40,28 @@ fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
+    static mut VERTS: [Projected; VERTICES] = [Projected {
+        x: 0.0,
+        y: 0.0,
+        rhw: 0.0,
+    }; VERTICES];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 40, 1);
-    let ok = all::<Fast>(COLOR, DEPTH, &mut counter);
+    let ok = all::<Fast>(COLOR, DEPTH, VERTS, &mut counter);
     // `--features size-probe` links the default path only, to measure the library's share of .text (README).
     #[cfg(not(feature = "size-probe"))]
     let ok = ok
-        & all::<Exact>(COLOR, DEPTH, &mut counter)
-        & all::<PrevPixel>(COLOR, DEPTH, &mut counter);
+        & all::<Exact>(COLOR, DEPTH, VERTS, &mut counter)
+        & all::<PrevPixel>(COLOR, DEPTH, VERTS, &mut counter);
     // `--features f32-div` adds the f32-division reciprocal (one VDIV on this core), for comparison (README).
     #[cfg(feature = "f32-div")]
-    let ok =
-        ok & all::<wraster::recip::PerPixel<wraster::recip::F32Div>>(COLOR, DEPTH, &mut counter);
+    let ok = ok
+        & all::<wraster::recip::PerPixel<wraster::recip::F32Div>>(
+            COLOR,
+            DEPTH,
+            VERTS,
+            &mut counter,
+        );
     debug::exit(if ok {
         debug::EXIT_SUCCESS
     } else {

@@ -11,8 +11,10 @@
 
 use riscv_rt::entry;
 use riscv_semihosting::{debug, hprintln};
+use wraster::mesh::Projected;
 use wraster::recip::{Exact, Fast, PrevPixel, SpanRecip};
-use wraster_board::{run_all, Counter, HEIGHT, WIDTH};
+use wraster::scenes::torus::VERTICES;
+use wraster_board::{run_all, run_torus_line, Counter, HEIGHT, WIDTH};
 
 const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
 
@@ -27,12 +29,20 @@ impl Counter for Minstret {
     }
 }
 
-fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16]) -> bool {
+fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], verts: &mut [Projected]) -> bool {
     run_all::<R, _>(
         "qemu-rv32",
         "rv32",
         color,
         depth,
+        &mut Minstret(0),
+        |line| hprintln!("{}", line),
+    ) & run_torus_line::<R, _>(
+        "qemu-rv32",
+        "rv32",
+        color,
+        depth,
+        verts,
         &mut Minstret(0),
         |line| hprintln!("{}", line),
     )
@@ -42,9 +52,10 @@ fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16]) -> bool {
 fn main() -> ! {
     // The frame lives on the stack (riscv-rt gives it the top of the 16 MiB RAM): no `static mut`, no unsafe.
     let (mut color, mut depth) = ([0u16; PIXELS], [0u16; PIXELS]);
-    let ok = all::<Fast>(&mut color, &mut depth)
-        & all::<Exact>(&mut color, &mut depth)
-        & all::<PrevPixel>(&mut color, &mut depth);
+    let mut verts = [Projected::default(); VERTICES];
+    let ok = all::<Fast>(&mut color, &mut depth, &mut verts)
+        & all::<Exact>(&mut color, &mut depth, &mut verts)
+        & all::<PrevPixel>(&mut color, &mut depth, &mut verts);
     debug::exit(if ok {
         debug::EXIT_SUCCESS
     } else {

@@ -1,8 +1,9 @@
 //! wraster on a Raspberry Pi Pico (RP2040, Cortex-M0+, thumbv6m-none-eabi) driving a 240x240 ST7789 over SPI.
 //!
-//! Renders the terrain demo (W_near 10, W_far 10000) band by band, 16 rows at a time (a 320x16 colour band and a
-//! 320x16 W16 band, 20 KiB, in RAM), and pushes the middle 240 columns of each finished band to the display with
-//! `mipidsi`, so the whole 320x240 frame never exists in RAM. This board only builds here (there is no emulator for
+//! Renders the terrain demo (W_near 10, W_far 10000) once, then W4's torus rotating, frame after frame, through the
+//! mesh path (each frame transformed once into 6 KiB, then drawn band by band), 16 rows at a time (a 320x16 colour
+//! band and a 320x16 W16 band, 20 KiB, in RAM), and pushes the middle 240 columns of each finished band to the
+//! display with `mipidsi`, so the whole 320x240 frame never exists in RAM. This board only builds here (there is no emulator for
 //! it); the README says how to flash it.
 //!
 //! Wiring (SPI0): SCK GP18, MOSI GP19, CS GP17, DC GP16, RST GP20, backlight GP21 (high = on).
@@ -20,8 +21,10 @@ use rp2040_hal::clocks::{init_clocks_and_plls, Clock};
 use rp2040_hal::fugit::RateExtU32;
 use rp2040_hal::gpio::{FunctionSpi, Pins};
 use rp2040_hal::{entry, pac, Sio, Spi, Timer, Watchdog};
+use wraster::mesh::Projected;
 use wraster::recip::Fast;
-use wraster_board::{run_scene_with, NoCounter, SCENES, WIDTH};
+use wraster::scenes::torus::VERTICES;
+use wraster_board::{run_scene_with, run_torus_with, NoCounter, SCENES, WIDTH};
 
 /// The second-stage boot loader for the Pico's W25Q080 flash.
 #[link_section = ".boot2"]
@@ -84,22 +87,28 @@ fn main() -> ! {
     let terrain = SCENES.iter().find(|s| s.name == "terrain").unwrap();
     let mut color = [0u16; WIDTH as usize * BAND_ROWS];
     let mut depth = [0u16; WIDTH as usize * BAND_ROWS];
-    let _ = run_scene_with::<Fast, _>(
-        terrain,
-        &mut color,
-        &mut depth,
-        &mut NoCounter,
-        |y0, band| {
-            let rows = band.len() / WIDTH as usize;
-            let pixels = (0..rows).flat_map(|r| {
-                band[r * WIDTH as usize + LEFT..r * WIDTH as usize + LEFT + SIDE as usize]
-                    .iter()
-                    .map(|&p| Rgb565::from(RawU16::new(p)))
-            });
-            let _ = display.set_pixels(0, y0, SIDE - 1, y0 + rows as u16 - 1, pixels);
-        },
-    );
+    let mut push = |y0: u16, band: &[u16]| {
+        let rows = band.len() / WIDTH as usize;
+        let pixels = (0..rows).flat_map(|r| {
+            band[r * WIDTH as usize + LEFT..r * WIDTH as usize + LEFT + SIDE as usize]
+                .iter()
+                .map(|&p| Rgb565::from(RawU16::new(p)))
+        });
+        let _ = display.set_pixels(0, y0, SIDE - 1, y0 + rows as u16 - 1, pixels);
+    };
+    let _ = run_scene_with::<Fast, _>(terrain, &mut color, &mut depth, &mut NoCounter, &mut push);
+    let mut verts = [Projected::default(); VERTICES];
+    let mut k = 0;
     loop {
-        cortex_m::asm::wfi();
+        let _ = run_torus_with::<Fast, _>(
+            &mut color,
+            &mut depth,
+            &mut verts,
+            &mut NoCounter,
+            k..k + 1,
+            &mut push,
+        );
+        // sin_cos is accurate for angles up to 6000 rad: 0.6 k stays within that
+        k = (k + 1) % 10_000;
     }
 }
