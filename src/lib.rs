@@ -80,6 +80,8 @@ mod error;
 mod fast;
 mod fixed;
 pub mod format;
+#[cfg(feature = "lighting")]
+pub mod lighting;
 pub mod mesh;
 pub mod packed;
 pub mod projection;
