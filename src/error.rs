@@ -2,7 +2,8 @@
 
 use core::fmt;
 
-/// Why a triangle, a render state or a buffer was refused. Nothing is written when one of these is returned.
+/// Why a triangle, a render state or a buffer was refused. Nothing is written when one of these is returned, except
+/// [`Error::Target`] (a colour target that failed part-way: see there).
 #[non_exhaustive]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Error {
@@ -23,7 +24,11 @@ pub enum Error {
         /// Elements given.
         actual: usize,
     },
-    /// The colour target returned an error.
+    /// The colour target returned an error (its own error value is not kept: this enum has no type parameter).
+    /// The draw stops at the failing run, and leaves: every row above it drawn completely (colour and depth); in its
+    /// row, the depth codes of the pixels walked before the failing run was written (a prefix of the span) and the
+    /// colour of the runs written before it (plus whatever the target wrote of the failing run itself); no pixel of
+    /// a later row. A mesh draw stops at the failing triangle; the triangles before it are drawn.
     Target,
     /// Z buffering asked for with a depth format that stores W (see [`crate::DepthMode`]).
     ZWithWFormat,

@@ -65,6 +65,47 @@
 //! assert!(r.draw_line_format(&mut Screen, Some(&mut depth), &[a, b])?.fragments > 20);
 //! # Ok::<(), wraster::Error>(())
 //! ```
+//!
+//! From world space: a [`projection::Camera`] (a W-friendly perspective, so its depth planes are the render state's),
+//! and an indexed [`mesh::Mesh`] drawn with one call, each vertex transformed once, back faces culled, clipped
+//! against the near plane in f32 (no f64 anywhere the firmware links):
+//!
+//! ```
+//! use embedded_graphics_core::pixelcolor::Rgb565;
+//! use embedded_graphics_core::prelude::*;
+//! use wraster::clip::Viewport;
+//! use wraster::mesh::{Colors, Mesh, Projected};
+//! use wraster::projection::{Camera, Mat4};
+//! use wraster::{DepthStore, Rasterizer};
+//!
+//! # struct Screen;
+//! # impl OriginDimensions for Screen { fn size(&self) -> Size { Size::new(64, 48) } }
+//! # impl DrawTarget for Screen {
+//! #     type Color = Rgb565; type Error = core::convert::Infallible;
+//! #     fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(&mut self, _: I) -> Result<(), Self::Error> { Ok(()) }
+//! # }
+//! // A tetrahedron, counter-clockwise seen from outside, one colour per face.
+//! let positions = [[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]];
+//! let indices = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]];
+//! let faces = [Rgb565::RED, Rgb565::GREEN, Rgb565::BLUE, Rgb565::YELLOW];
+//! let mesh = Mesh { positions: &positions, indices: &indices, colors: Colors::PerFace(&faces) };
+//!
+//! // Eye at (0, 0, 4) looking at the origin; 60 degree field of view, aspect = width / height.
+//! let camera = Camera::look_at([0.0, 0.0, 4.0], [0.0; 3], [0.0, 1.0, 0.0],
+//!                              core::f32::consts::FRAC_PI_3, 64.0 / 48.0, 0.5, 100.0)?;
+//! let mut r: Rasterizer = Rasterizer::new(camera.render_state()?); // depth range 0.5..100, back faces culled
+//! let mut depth = DepthStore::<64, 48>::new();
+//! let mut scratch = [Projected::default(); 4]; // one per vertex, caller-owned: no allocation
+//! let vp = Viewport::new(0.0, 0.0, 64.0, 48.0);
+//! for frame in 0..3 {
+//!     depth.view().clear();
+//!     let model = Mat4::rotation_y(0.5 * frame as f32) * Mat4::translation([0.0, 0.0, -1.0]);
+//!     let m = camera.model_matrix(&model);
+//!     let stats = r.draw_mesh(&mut Screen, &mut depth.view(), &mesh, &m, &vp, &mut scratch)?;
+//!     assert!(stats.written > 100 && stats.culled >= 1);
+//! }
+//! # Ok::<(), wraster::Error>(())
+//! ```
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

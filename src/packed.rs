@@ -379,7 +379,7 @@ impl<R: WSpan> Rasterizer<R> {
 
     /// Draws one flat-coloured triangle into `target` and a depth buffer of any format (or none: depth off; the rows
     /// and columns are then the target's). The depth test runs before any colour work for the pixel (the Windows CE "Depth Buffering" docs): a
-    /// passing pixel's colour is sent with its run. On an error nothing is written.
+    /// passing pixel's colour is sent with its run. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
     pub fn draw_format<F: Codec, D>(
         &mut self,
         target: &mut D,
@@ -527,7 +527,7 @@ impl<R: WSpan> Rasterizer<R> {
 /// `(1 + k) / 2` units of `2^-F`). A wireframe triangle is culled like a solid one and draws its three edges with the
 /// triangle's depth bias, in its first vertex's colour.
 impl<R: WSpan> Rasterizer<R> {
-    /// Draws one point. On an error nothing is written.
+    /// Draws one point. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
     pub fn draw_point_format<F: Codec, D>(
         &mut self,
         target: &mut D,
@@ -550,7 +550,7 @@ impl<R: WSpan> Rasterizer<R> {
         self.pixels::<F, D>(target, depth, &line, 1, at, 0, s.frac, v.color)
     }
 
-    /// Draws one line from `v[0]` to `v[1]` (flat, `v[0]`'s colour). On an error nothing is written.
+    /// Draws one line from `v[0]` to `v[1]` (flat, `v[0]`'s colour). On an error nothing is written, except for a failing `target` ([`Error::Target`]).
     pub fn draw_line_format<F: Codec, D>(
         &mut self,
         target: &mut D,

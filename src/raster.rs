@@ -298,7 +298,7 @@ impl<R: SpanRecip> Rasterizer<R> {
     }
 
     /// Draws one flat-coloured triangle (the colour of its first vertex) into a W16 buffer: the lean path.
-    /// On an error nothing is written.
+    /// On an error nothing is written, except for a failing `target` ([`Error::Target`] says what is left).
     pub fn draw<D>(
         &mut self,
         target: &mut D,
@@ -348,7 +348,7 @@ impl<R: SpanRecip> Rasterizer<R> {
 
     /// Draws one triangle with its vertex colours interpolated perspective-correctly (feature `gouraud`): each
     /// channel `c` is carried as the plane of `c * t` (linear in screen space) and divided per pixel by `t` with the
-    /// same reciprocal as the depth, then rounded to 8 bits. On an error nothing is written.
+    /// same reciprocal as the depth, then rounded to 8 bits. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
     #[cfg(feature = "gouraud")]
     pub fn draw_gouraud<D>(
         &mut self,

@@ -264,7 +264,7 @@ impl<R: Recip32> SpanRecip for PerPixel<R> {
 }
 
 /// The fast tier (the default): W16 spans drawn with `Less` and depth write take the 32-bit loop of the fast tier
-/// (a reciprocal carried along the span, the depth test ahead of it; bound [`crate::fast::FAST_MAX_REL_ERROR`], under
+/// (a reciprocal carried along the span, the depth test ahead of it; bound `FAST_MAX_REL_ERROR` (crate-private), under
 /// `2^-11` of a code); everything else (other comparisons, bias, spans crossing a depth plane, the packed formats) uses
 /// [`DefaultRecip`] per pixel, like the exact tier.
 #[derive(Default)]

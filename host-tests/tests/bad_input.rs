@@ -151,3 +151,105 @@ fn drawing_is_clipped_to_the_band() {
         assert!(n == 0 || (10..15).contains(&y));
     }
 }
+
+/// A colour target that fails once it has been handed `budget` pixels (before writing the run that exceeds it).
+struct Failing {
+    inner: host_tests::Frame,
+    budget: usize,
+}
+
+impl embedded_graphics::prelude::OriginDimensions for Failing {
+    fn size(&self) -> embedded_graphics::prelude::Size {
+        self.inner.size()
+    }
+}
+
+impl embedded_graphics::prelude::DrawTarget for Failing {
+    type Color = Rgb565;
+    type Error = ();
+    fn draw_iter<I: IntoIterator<Item = embedded_graphics::Pixel<Rgb565>>>(
+        &mut self,
+        px: I,
+    ) -> Result<(), ()> {
+        let px: Vec<_> = px.into_iter().collect();
+        if px.len() > self.budget {
+            return Err(());
+        }
+        self.budget -= px.len();
+        self.inner.draw_iter(px).map_err(|_| ())
+    }
+}
+
+/// What a failing colour target leaves behind (the contract `Error::Target` documents): every row above the failing
+/// one is drawn completely, colour and depth; in the failing row a prefix of the span has its depth codes (the
+/// pixels walked before the failing run was written) and colour only where depth is; no row below is touched.
+#[test]
+fn a_failing_target_leaves_whole_rows_and_a_prefix() {
+    let tri = [
+        Vertex::new(3.5, 2.5, 20.0, Rgb565::RED),
+        Vertex::new(60.5, 9.5, 900.0, Rgb565::RED),
+        Vertex::new(12.5, 40.5, 100.0, Rgb565::RED),
+    ];
+    let (w, h) = (64u16, 48u16);
+    let full = host_tests::render::<wraster::recip::Fast>(
+        &[tri],
+        RenderState::new(10.0, 1000.0).unwrap(),
+        w,
+        h,
+        h,
+    )
+    .unwrap();
+    for budget in [0, 1, 100, 333, 800] {
+        let mut target = Failing {
+            inner: host_tests::Frame::new(w as u32, h as u32),
+            budget,
+        };
+        let mut depth = vec![0u16; w as usize * h as usize];
+        let mut buf = DepthBuffer::new(&mut depth, w, h).unwrap();
+        buf.clear();
+        let mut r: Rasterizer = Rasterizer::new(RenderState::new(10.0, 1000.0).unwrap());
+        assert_eq!(
+            r.draw(&mut target, &mut buf, &tri),
+            Err(Error::Target),
+            "budget {budget}"
+        );
+        let rows_equal = |j: usize| {
+            let s = j * w as usize..(j + 1) * w as usize;
+            depth[s.clone()] == full.1[s.clone()] && target.inner.px[s.clone()] == full.0.px[s]
+        };
+        let jf = (0..h as usize)
+            .find(|&j| !rows_equal(j))
+            .expect("some row is incomplete");
+        for j in jf + 1..h as usize {
+            let s = j * w as usize..(j + 1) * w as usize;
+            assert!(
+                depth[s.clone()].iter().all(|&d| d == W16_FAR),
+                "budget {budget}: row {j} touched"
+            );
+            assert!(target.inner.writes[s].iter().all(|&n| n == 0));
+        }
+        let row = jf * w as usize;
+        let stored: Vec<bool> = (0..w as usize).map(|i| depth[row + i] != W16_FAR).collect();
+        let first = stored.iter().position(|&s| s);
+        let last = stored.iter().rposition(|&s| s);
+        if let (Some(a), Some(b)) = (first, last) {
+            assert!(
+                stored[a..=b].iter().all(|&s| s),
+                "budget {budget}: depth not a prefix"
+            );
+            for i in a..=b {
+                assert_eq!(depth[row + i], full.1[row + i]);
+            }
+        }
+        for i in 0..w as usize {
+            if target.inner.writes[row + i] > 0 {
+                assert!(stored[i], "budget {budget}: colour without depth at {i}");
+            }
+        }
+        assert_eq!(
+            target.inner.writes.iter().sum::<u32>() as usize,
+            budget - target.budget,
+            "every pixel handed to the target before the failure is in the frame"
+        );
+    }
+}
