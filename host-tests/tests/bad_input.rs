@@ -241,9 +241,9 @@ fn a_failing_target_leaves_whole_rows_and_a_prefix() {
                 assert_eq!(depth[row + i], full.1[row + i]);
             }
         }
-        for i in 0..w as usize {
+        for (i, &s) in stored.iter().enumerate() {
             if target.inner.writes[row + i] > 0 {
-                assert!(stored[i], "budget {budget}: colour without depth at {i}");
+                assert!(s, "budget {budget}: colour without depth at {i}");
             }
         }
         assert_eq!(
