@@ -11,7 +11,7 @@
 
 use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 
-use crate::projection::{sqrt, Mat4};
+use crate::projection::{unit, Mat4};
 use crate::Error;
 
 /// A directional light with an ambient term.
@@ -23,11 +23,6 @@ pub struct Light {
     pub ambient: f32,
     /// Diffuse intensity, `[0, 1]`.
     pub diffuse: f32,
-}
-
-fn unit(v: [f32; 3]) -> Option<[f32; 3]> {
-    let n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    (n > 0.0 && n.is_finite()).then(|| v.map(|c| c / n))
 }
 
 /// `v` through the upper 3x3 of `m` (row vectors).

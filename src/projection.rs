@@ -103,7 +103,8 @@ fn cross3(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
 fn dot3(a: [f32; 3], b: [f32; 3]) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
-fn unit(a: [f32; 3]) -> Option<[f32; 3]> {
+/// `a / |a|`, or `None` for a zero or non-finite length.
+pub(crate) fn unit(a: [f32; 3]) -> Option<[f32; 3]> {
     let n = sqrt(dot3(a, a));
     (n > 0.0 && n.is_finite()).then(|| a.map(|c| c / n))
 }

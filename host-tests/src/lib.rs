@@ -246,6 +246,25 @@ pub fn render<R: SpanRecip>(
     let mut frame = Frame::new(w as u32, h as u32);
     let mut depth = vec![0u16; w as usize * h as usize];
     let mut r = Rasterizer::<R>::new(state);
+    let stats = in_bands(&mut depth, w, h, band_h, |buf| {
+        let mut stats = Stats::default();
+        for t in tris {
+            stats += r.draw(&mut frame, buf, t)?;
+        }
+        Ok(stats)
+    })?;
+    Ok((frame, depth, stats))
+}
+
+/// Splits `depth` (`w x h`) into bands of `band_h` rows (the last may be shorter), clears each and draws it with
+/// `draw`; the summed stats.
+pub fn in_bands(
+    depth: &mut [u16],
+    w: u16,
+    h: u16,
+    band_h: u16,
+    mut draw: impl FnMut(&mut DepthBuffer<'_>) -> Result<Stats, Error>,
+) -> Result<Stats, Error> {
     let mut stats = Stats::default();
     let mut y0 = 0u16;
     while y0 < h {
@@ -253,12 +272,10 @@ pub fn render<R: SpanRecip>(
         let slice = &mut depth[y0 as usize * w as usize..(y0 + bh) as usize * w as usize];
         let mut buf = DepthBuffer::band(slice, w, y0 as i32, bh)?;
         buf.clear();
-        for t in tris {
-            stats += r.draw(&mut frame, &mut buf, t)?;
-        }
+        stats += draw(&mut buf)?;
         y0 += bh;
     }
-    Ok((frame, depth, stats))
+    Ok(stats)
 }
 
 /// A random coordinate: mostly anywhere in and around the frame, sometimes on a pixel centre, sometimes on a
@@ -466,15 +483,8 @@ pub fn render_torus<R: SpanRecip>(
         &vp,
         &mut scratch,
     )?;
-    let mut stats = Stats::default();
-    let mut y0 = 0u16;
-    while y0 < h {
-        let bh = band_h.min(h - y0);
-        let slice = &mut depth[y0 as usize * w as usize..(y0 + bh) as usize * w as usize];
-        let mut buf = DepthBuffer::band(slice, w, y0 as i32, bh)?;
-        buf.clear();
-        stats += r.draw_mesh_frame(&mut frame, &mut buf, &mf)?;
-        y0 += bh;
-    }
+    let stats = in_bands(&mut depth, w, h, band_h, |buf| {
+        r.draw_mesh_frame(&mut frame, buf, &mf)
+    })?;
     Ok((frame, depth, stats))
 }
