@@ -16,14 +16,17 @@ pub(crate) fn split(v: f32) -> Option<(bool, u32, i32)> {
     }
 }
 
-/// `round(m * 2^e)` for `m < 2^48`, ties to even, saturating at `i64::MAX` (callers range-check the input first).
+/// `round(m * 2^e)` for any `m` (an f32 mantissa times the far plane's, or a 32-bit fixed-point `1/W` times it:
+/// not normalised, so a small `m` may take a large `e`), ties to even, saturating at `i64::MAX` (callers
+/// range-check the input first).
 #[inline]
 pub(crate) fn round_shift(m: u64, e: i32) -> u64 {
     if m == 0 {
         return 0;
     }
     if e >= 0 {
-        if e >= 15 {
+        // m * 2^e >= 2^63 when e reaches m's leading zeros.
+        if e >= m.leading_zeros() as i32 {
             return i64::MAX as u64;
         }
         m << e
@@ -122,6 +125,20 @@ pub(crate) fn div_u128_shift(n: u128, d: u64) -> u128 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A mantissa that is not normalised (a 32-bit fixed-point `1/W` with leading zeros) takes a large left shift:
+    /// exact up to 2^63, saturating from there. (Found by the fixed-point input's equality with f32: the old limit
+    /// `e < 15` assumed a 48-bit mantissa and saturated `1.85e6 << 16`.)
+    #[test]
+    fn round_shift_left_is_exact_until_it_saturates() {
+        assert_eq!(round_shift(1_850_000, 16), 1_850_000 << 16);
+        assert_eq!(round_shift(1, 62), 1 << 62);
+        assert_eq!(round_shift(1, 63), i64::MAX as u64);
+        assert_eq!(round_shift(3, 62), i64::MAX as u64);
+        assert_eq!(round_shift(u64::MAX >> 1, 0), u64::MAX >> 1);
+        assert_eq!(round_shift(5, -1), 2); // 2.5 ties to even
+        assert_eq!(round_shift(7, -1), 4); // 3.5 ties to even
+    }
 
     #[test]
     fn to_fixed_matches_exact_rounding() {

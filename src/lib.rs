@@ -121,6 +121,7 @@ mod error;
 mod fast;
 mod fixed;
 pub mod format;
+pub mod input;
 #[cfg(feature = "lighting")]
 pub mod lighting;
 pub mod mesh;
@@ -134,6 +135,7 @@ mod state;
 
 pub use depth::{DepthBuffer, DepthStore, W16_FAR};
 pub use error::Error;
+pub use input::{FixedVertex, VertexInput};
 pub use packed::{Codec, Packed, Resolved};
 pub use raster::{row_range, Rasterizer, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS};
 pub use state::{Compare, Cull, DepthMode, DepthRange, RenderState, MAX_T};

@@ -23,9 +23,10 @@ use embedded_graphics_core::primitives::Rectangle;
 use crate::edge::Sub;
 use crate::fixed::{div_u128, split};
 use crate::format::{DepthFormat, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
+use crate::input::VertexInput;
 #[cfg(feature = "bias")]
 use crate::raster::slope_bias;
-use crate::raster::{div_round, Plane, Runs, Stats, Vertex};
+use crate::raster::{div_round, Plane, Runs, Stats};
 #[cfg(feature = "bias")]
 use crate::recip::exact_u;
 use crate::recip::WSpan;
@@ -380,13 +381,14 @@ impl<R: WSpan> Rasterizer<R> {
     /// Draws one flat-coloured triangle into `target` and a depth buffer of any format (or none: depth off; the rows
     /// and columns are then the target's). The depth test runs before any colour work for the pixel (the Windows CE "Depth Buffering" docs): a
     /// passing pixel's colour is sent with its run. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_format<F: Codec, D>(
+    pub fn draw_format<F: Codec, D, V>(
         &mut self,
         target: &mut D,
         mut depth: Option<&mut Packed<'_, F>>,
-        v: &[Vertex<D::Color>; 3],
+        v: &[V; 3],
     ) -> Result<Stats, Error>
     where
+        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor,
     {
@@ -418,7 +420,7 @@ impl<R: WSpan> Rasterizer<R> {
             cmp: self.state.compare,
             write: self.state.depth_write,
         };
-        let color = v[0].color;
+        let color = v[0].color();
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {
             if let Some((lo, hi)) = w.row(width) {
@@ -528,13 +530,14 @@ impl<R: WSpan> Rasterizer<R> {
 /// triangle's depth bias, in its first vertex's colour.
 impl<R: WSpan> Rasterizer<R> {
     /// Draws one point. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_point_format<F: Codec, D>(
+    pub fn draw_point_format<F: Codec, D, V>(
         &mut self,
         target: &mut D,
         depth: Option<&mut Packed<'_, F>>,
-        v: &Vertex<D::Color>,
+        v: &V,
     ) -> Result<Stats, Error>
     where
+        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor,
     {
@@ -547,17 +550,18 @@ impl<R: WSpan> Rasterizer<R> {
             dz: 0,
         };
         let at = |_k: usize| (s.p[0].x >> 8, s.p[0].y >> 8);
-        self.pixels::<F, D>(target, depth, &line, 1, at, 0, s.frac, v.color)
+        self.pixels::<F, D>(target, depth, &line, 1, at, 0, s.frac, v.color())
     }
 
     /// Draws one line from `v[0]` to `v[1]` (flat, `v[0]`'s colour). On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_line_format<F: Codec, D>(
+    pub fn draw_line_format<F: Codec, D, V>(
         &mut self,
         target: &mut D,
         depth: Option<&mut Packed<'_, F>>,
-        v: &[Vertex<D::Color>; 2],
+        v: &[V; 2],
     ) -> Result<Stats, Error>
     where
+        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor,
     {
@@ -569,19 +573,20 @@ impl<R: WSpan> Rasterizer<R> {
             (s.t[0], s.t[1]),
             s.frac,
             0,
-            v[0].color,
+            v[0].color(),
         )
     }
 
     /// Draws the three edges of a triangle, culled like a solid one, with its depth bias. On an error nothing is
     /// written.
-    pub fn draw_wireframe_format<F: Codec, D>(
+    pub fn draw_wireframe_format<F: Codec, D, V>(
         &mut self,
         target: &mut D,
         mut depth: Option<&mut Packed<'_, F>>,
-        v: &[Vertex<D::Color>; 3],
+        v: &[V; 3],
     ) -> Result<Stats, Error>
     where
+        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor,
     {
@@ -613,7 +618,7 @@ impl<R: WSpan> Rasterizer<R> {
                 (s.t[a], s.t[b]),
                 s.frac,
                 bias,
-                v[0].color,
+                v[0].color(),
             )?;
         }
         Ok(stats)

@@ -17,7 +17,8 @@ use embedded_graphics_core::primitives::Rectangle;
 
 use crate::depth::{encode_w16, DepthBuffer, W16_FAR};
 use crate::edge::{Edge, Sub};
-use crate::fixed::{div_u128, round_shift, split, to_fixed};
+use crate::fixed::{div_u128, round_shift, split};
+use crate::input::VertexInput;
 #[cfg(feature = "gouraud")]
 use crate::recip::Inv;
 use crate::recip::{normalise, Fast, SpanRecip, SpanWalker, WSpan};
@@ -31,7 +32,6 @@ use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 pub const SUBPIXEL_BITS: u32 = 8;
 /// Vertices must have `|x|, |y| < GUARD_BAND` pixels (see ARCHITECTURE.md for why this is safe in i64).
 pub const GUARD_BAND: i32 = 4096;
-const GUARD_LOG2: i32 = 12;
 
 /// A transformed-and-lit vertex, like Direct3D's TLVERTEX: `x`, `y` in pixels (pixel centres at `i + 0.5`), `z`,
 /// `rhw = 1/W`, and a colour. Every depth mode takes its depth from `rhw` and the depth range (Z modes compute D3D's
@@ -89,23 +89,10 @@ pub(crate) struct Setup<const N: usize = 3> {
     pub(crate) frac: u32,
 }
 
-// Out of line: one copy instead of one per coordinate (flash), for a few instructions per vertex.
-#[inline(never)]
-fn snap(v: f32) -> Result<i32, Error> {
-    match to_fixed(v, SUBPIXEL_BITS as i32, GUARD_LOG2) {
-        Ok(s) => Ok(s as i32),
-        Err(false) => Err(Error::NonFinite),
-        Err(true) => Err(Error::OutOfGuardBand),
-    }
-}
-
 /// `rhw * W_far` as an exact product of mantissas, `(m, e)` with the value `m * 2^e`.
 #[inline(never)]
-fn t_of(rhw: f32, far: (u32, i32)) -> Result<(u64, i32), Error> {
-    let (neg, m, e) = split(rhw).ok_or(Error::NonFinite)?;
-    if neg || m == 0 {
-        return Err(Error::RhwNotPositive);
-    }
+fn t_of(rhw: (u32, i32), far: (u32, i32)) -> Result<(u64, i32), Error> {
+    let (m, e) = rhw;
     let pm = m as u64 * far.0 as u64;
     let pe = e + far.1;
     if 64 - pm.leading_zeros() as i32 + pe > MAX_T_LOG2 {
@@ -125,13 +112,11 @@ fn rows_of(p: &[Sub; 3]) -> (i32, i32) {
 
 /// The frame rows `(first, last)` a triangle can cover (inclusive; empty when `first > last`), after snapping:
 /// for binning triangles into bands without setting them up. Errors as [`Rasterizer::draw`] for x and y.
-pub fn row_range<C>(v: &[Vertex<C>; 3]) -> Result<(i32, i32), Error> {
+pub fn row_range<V: VertexInput>(v: &[V; 3]) -> Result<(i32, i32), Error> {
     let mut p = [Sub { x: 0, y: 0 }; 3];
     for (q, v) in p.iter_mut().zip(v) {
-        *q = Sub {
-            x: snap(v.x)?,
-            y: snap(v.y)?,
-        };
+        let (x, y) = v.snapped()?;
+        *q = Sub { x, y };
     }
     Ok(rows_of(&p))
 }
@@ -169,19 +154,18 @@ impl<R: WSpan> Rasterizer<R> {
     }
 
     /// Snaps and checks `N` vertices and gives their `T` with a common fraction count.
-    pub(crate) fn setup<C, const N: usize>(&self, v: &[Vertex<C>; N]) -> Result<Setup<N>, Error> {
+    pub(crate) fn setup<V: VertexInput, const N: usize>(
+        &self,
+        v: &[V; N],
+    ) -> Result<Setup<N>, Error> {
         let (_, fm, fe) = split(self.state.range.far()).ok_or(Error::NonFinite)?;
         let mut p = [Sub { x: 0, y: 0 }; N];
         let mut tm = [(0u64, 0i32); N];
         for k in 0..N {
-            if !v[k].z.is_finite() {
-                return Err(Error::NonFinite);
-            }
-            p[k] = Sub {
-                x: snap(v[k].x)?,
-                y: snap(v[k].y)?,
-            };
-            tm[k] = t_of(v[k].rhw, (fm, fe))?;
+            let r = v[k].rhw_exact()?;
+            let (x, y) = v[k].snapped()?;
+            p[k] = Sub { x, y };
+            tm[k] = t_of(r, (fm, fe))?;
         }
         // F = 61 - bits(floor(t_max)), t_max < 2^30.
         let int_bits = tm
@@ -199,9 +183,9 @@ impl<R: WSpan> Rasterizer<R> {
     /// `rows` is the buffer's first frame row and its height.
     /// `fast`: the fast tier's set-up for small triangles (32-bit edges, the plane from a reciprocal of the area,
     /// [`Plane::solve_fast`]) where it applies; the exact set-up otherwise.
-    pub(crate) fn prepare<C>(
+    pub(crate) fn prepare<V: VertexInput>(
         &self,
-        v: &[Vertex<C>; 3],
+        v: &[V; 3],
         rows: (i32, u16),
         fast: bool,
     ) -> Result<Result<Walk, Stats>, Error> {
@@ -299,13 +283,14 @@ impl<R: SpanRecip> Rasterizer<R> {
 
     /// Draws one flat-coloured triangle (the colour of its first vertex) into a W16 buffer: the lean path.
     /// On an error nothing is written, except for a failing `target` ([`Error::Target`] says what is left).
-    pub fn draw<D>(
+    pub fn draw<D, V>(
         &mut self,
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
-        v: &[Vertex<D::Color>; 3],
+        v: &[V; 3],
     ) -> Result<Stats, Error>
     where
+        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor,
     {
@@ -314,7 +299,7 @@ impl<R: SpanRecip> Rasterizer<R> {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
         };
-        let color = v[0].color;
+        let color = v[0].color();
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {
             if let Some((lo, hi)) = w.row(depth.width()) {
@@ -350,13 +335,14 @@ impl<R: SpanRecip> Rasterizer<R> {
     /// channel `c` is carried as the plane of `c * t` (linear in screen space) and divided per pixel by `t` with the
     /// same reciprocal as the depth, then rounded to 8 bits. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
     #[cfg(feature = "gouraud")]
-    pub fn draw_gouraud<D>(
+    pub fn draw_gouraud<D, V>(
         &mut self,
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
-        v: &[Vertex<D::Color>; 3],
+        v: &[V; 3],
     ) -> Result<Stats, Error>
     where
+        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor + From<Rgb888> + Into<Rgb888>,
     {
@@ -368,7 +354,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         };
         // Q = c * (T >> 8) < T for c <= 255, so Q << lz fits wherever T << lz does.
         let rgb = v.map(|q| {
-            let c: Rgb888 = q.color.into();
+            let c: Rgb888 = q.color().into();
             [c.r(), c.g(), c.b()]
         });
         let mut planes = [0, 1, 2]

@@ -1,0 +1,112 @@
+//! Vertex input: the f32 [`Vertex`] and the fixed-point [`FixedVertex`], behind one sealed trait, [`VertexInput`].
+//!
+//! A core without an FPU can feed the rasterizer without a single float operation: `x` and `y` as
+//! [`I24F8`] (the 16.8 snap grid itself, so snapping is a range check), and `1/W` as any 32-bit unsigned
+//! [`fixed`] type, the integer/fraction split chosen for the scene's depth range (`U1F31` resolves `1/W` to
+//! 2^-31, which keeps 17 significant bits at `W = 10^4`; a scene with `W < 1` needs integer bits for `1/W > 1`).
+//! The depth arithmetic is exact on either input (the product `rhw * W_far` is formed from the mantissas), so a
+//! fixed-point vertex whose values equal an f32 vertex's gives the same pixels and the same codes.
+
+use crate::fixed::split;
+use crate::raster::{Vertex, GUARD_BAND, SUBPIXEL_BITS};
+use crate::Error;
+use fixed::traits::Fixed;
+pub use fixed::types::{I24F8, U16F16, U1F31, U8F24};
+
+mod sealed {
+    pub trait Sealed {}
+}
+
+/// A vertex the rasterizer takes: [`Vertex`] (f32) or [`FixedVertex`] (fixed point). Sealed: the methods are the
+/// crate's exact conversions, not an extension point.
+pub trait VertexInput: sealed::Sealed + Copy {
+    /// The colour type.
+    type Color: Copy;
+    /// `x` and `y` on the 16.8 grid (round to nearest, ties to even), checked against [`GUARD_BAND`].
+    #[doc(hidden)]
+    fn snapped(&self) -> Result<(i32, i32), Error>;
+    /// `rhw` as an exact `(mantissa, exponent)` pair, `rhw = mantissa * 2^exponent`, mantissa below 2^32.
+    /// `Err(NonFinite)` for NaN and infinities (and a non-finite `z`), `Err(RhwNotPositive)` for `rhw <= 0`.
+    #[doc(hidden)]
+    fn rhw_exact(&self) -> Result<(u32, i32), Error>;
+    /// The vertex colour.
+    fn color(&self) -> Self::Color;
+}
+
+// Out of line: one copy instead of one per coordinate (flash), for a few instructions per vertex.
+#[inline(never)]
+fn snap(v: f32) -> Result<i32, Error> {
+    match crate::fixed::to_fixed(v, SUBPIXEL_BITS as i32, 12) {
+        Ok(s) => Ok(s as i32),
+        Err(false) => Err(Error::NonFinite),
+        Err(true) => Err(Error::OutOfGuardBand),
+    }
+}
+
+impl<C> sealed::Sealed for Vertex<C> {}
+impl<C: Copy> VertexInput for Vertex<C> {
+    type Color = C;
+    #[inline]
+    fn snapped(&self) -> Result<(i32, i32), Error> {
+        Ok((snap(self.x)?, snap(self.y)?))
+    }
+    #[inline]
+    fn rhw_exact(&self) -> Result<(u32, i32), Error> {
+        if !self.z.is_finite() {
+            return Err(Error::NonFinite);
+        }
+        let (neg, m, e) = split(self.rhw).ok_or(Error::NonFinite)?;
+        if neg || m == 0 {
+            return Err(Error::RhwNotPositive);
+        }
+        Ok((m, e))
+    }
+    #[inline]
+    fn color(&self) -> C {
+        self.color
+    }
+}
+
+/// A screen-space vertex in fixed point: `x`, `y` in pixels on the 16.8 snap grid (pixel centres at `i + 0.5`),
+/// `rhw = 1/W` in the unsigned 32-bit fixed type `R` (default [`U1F31`], for `W > 0.5`). Draws exactly like the
+/// [`Vertex`] with the same values.
+///
+/// Ranges, checked at the draw: `|x|, |y| <` [`GUARD_BAND`] (else [`Error::OutOfGuardBand`]), `rhw > 0` (else
+/// [`Error::RhwNotPositive`]), `rhw * W_far` below [`crate::MAX_T`] (else [`Error::DepthRange`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FixedVertex<C, R = U1F31> {
+    /// Pixels, right.
+    pub x: I24F8,
+    /// Pixels, down.
+    pub y: I24F8,
+    /// `1 / W`.
+    pub rhw: R,
+    /// Colour.
+    pub color: C,
+}
+
+impl<C, R> sealed::Sealed for FixedVertex<C, R> {}
+impl<C: Copy, R: Fixed<Bits = u32>> VertexInput for FixedVertex<C, R> {
+    type Color = C;
+    #[inline]
+    fn snapped(&self) -> Result<(i32, i32), Error> {
+        let lim = GUARD_BAND << SUBPIXEL_BITS;
+        let (x, y) = (self.x.to_bits(), self.y.to_bits());
+        // The f32 path rejects |v| >= GUARD_BAND; the grid values are exact, so the same test.
+        if x <= -lim || x >= lim || y <= -lim || y >= lim {
+            return Err(Error::OutOfGuardBand);
+        }
+        Ok((x, y))
+    }
+    #[inline]
+    fn rhw_exact(&self) -> Result<(u32, i32), Error> {
+        match self.rhw.to_bits() {
+            0 => Err(Error::RhwNotPositive),
+            m => Ok((m, -(R::FRAC_NBITS as i32))),
+        }
+    }
+    #[inline]
+    fn color(&self) -> C {
+        self.color
+    }
+}
