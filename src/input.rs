@@ -10,7 +10,7 @@
 use crate::fixed::split;
 use crate::raster::{Vertex, GUARD_BAND, SUBPIXEL_BITS};
 use crate::Error;
-use fixed::traits::Fixed;
+pub use fixed::traits::Fixed;
 pub use fixed::types::{I24F8, U16F16, U1F31, U8F24};
 
 mod sealed {

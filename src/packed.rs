@@ -381,14 +381,13 @@ impl<R: WSpan> Rasterizer<R> {
     /// Draws one flat-coloured triangle into `target` and a depth buffer of any format (or none: depth off; the rows
     /// and columns are then the target's). The depth test runs before any colour work for the pixel (the Windows CE "Depth Buffering" docs): a
     /// passing pixel's colour is sent with its run. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_format<F: Codec, D, V>(
+    pub fn draw_format<F: Codec, D>(
         &mut self,
         target: &mut D,
         mut depth: Option<&mut Packed<'_, F>>,
-        v: &[V; 3],
+        v: &[impl VertexInput<Color = D::Color>; 3],
     ) -> Result<Stats, Error>
     where
-        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor,
     {
@@ -530,14 +529,13 @@ impl<R: WSpan> Rasterizer<R> {
 /// triangle's depth bias, in its first vertex's colour.
 impl<R: WSpan> Rasterizer<R> {
     /// Draws one point. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_point_format<F: Codec, D, V>(
+    pub fn draw_point_format<F: Codec, D>(
         &mut self,
         target: &mut D,
         depth: Option<&mut Packed<'_, F>>,
-        v: &V,
+        v: &impl VertexInput<Color = D::Color>,
     ) -> Result<Stats, Error>
     where
-        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor,
     {
@@ -554,14 +552,13 @@ impl<R: WSpan> Rasterizer<R> {
     }
 
     /// Draws one line from `v[0]` to `v[1]` (flat, `v[0]`'s colour). On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_line_format<F: Codec, D, V>(
+    pub fn draw_line_format<F: Codec, D>(
         &mut self,
         target: &mut D,
         depth: Option<&mut Packed<'_, F>>,
-        v: &[V; 2],
+        v: &[impl VertexInput<Color = D::Color>; 2],
     ) -> Result<Stats, Error>
     where
-        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor,
     {
@@ -579,14 +576,13 @@ impl<R: WSpan> Rasterizer<R> {
 
     /// Draws the three edges of a triangle, culled like a solid one, with its depth bias. On an error nothing is
     /// written.
-    pub fn draw_wireframe_format<F: Codec, D, V>(
+    pub fn draw_wireframe_format<F: Codec, D>(
         &mut self,
         target: &mut D,
         mut depth: Option<&mut Packed<'_, F>>,
-        v: &[V; 3],
+        v: &[impl VertexInput<Color = D::Color>; 3],
     ) -> Result<Stats, Error>
     where
-        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor,
     {

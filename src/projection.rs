@@ -41,7 +41,7 @@ impl Mat4 {
 }
 
 /// `sin` and `cos` of `x` in f32, for `|x| <= 6000` (beyond, the argument reduction loses bits and the result is only
-/// bounded by 1): the argument is reduced by `pi/2` in three parts (Cody and Waite), then Taylor polynomials to `r^9`
+/// bounded by 1; NaN for a NaN or an infinity): the argument is reduced by `pi/2` in three parts (Cody and Waite), then Taylor polynomials to `r^9`
 /// and `r^10` on `|r| <= pi/4` (truncation below `2e-9`). Error below `4e-7` absolute (five f32 roundings of terms
 /// at most 1, `5 * 2^-24 = 3e-7`, plus the truncation), checked against f64 in the tests. micromath's `sin`/`cos`
 /// document an error of 0.002: too coarse for a projection's planes or a rotation that a test compares with f64.
@@ -54,14 +54,15 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
         let q = x * core::f32::consts::FRAC_2_PI;
         // round half away from zero, without `f32::round` (std)
         let r = if q >= 0.0 { q + 0.5 } else { q - 0.5 };
-        if r.is_finite() && r.abs() < 8.0e6 {
-            r as i32
-        } else {
-            0
+        if !r.is_finite() {
+            return (f32::NAN, f32::NAN);
         }
+        r as i32 // saturates beyond 2^31 (x beyond 3e9, where the reduction below no longer reaches pi/4)
     };
     let kf = k as f32;
-    let r = ((x - kf * P1) - kf * P2) - kf * P3;
+    // Within |pi/4| plus a rounding wherever the result is accurate; the clamp only bounds the polynomials (and so
+    // the result, by 1) where the reduction has lost its bits. (A fuzz finding: sin_cos(f32::MAX) gave inf.)
+    let r = (((x - kf * P1) - kf * P2) - kf * P3).clamp(-0.786, 0.786);
     let r2 = r * r;
     let s =
         r * (1.0 + r2 * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0 + r2 / 362_880.0))));
@@ -553,6 +554,29 @@ mod tests {
         }
         std::println!("sin_cos worst {worst:e} (bound 4e-7)");
         assert!(worst < 4e-7, "{worst}");
+    }
+
+    /// Beyond the accurate range every finite argument still gives values bounded by 1, and a non-finite one NaN
+    /// (fuzz finding: `sin_cos(f32::MAX)` was `(inf, -inf)`).
+    #[test]
+    fn sin_cos_is_bounded_everywhere() {
+        for x in [
+            1.0e7f32,
+            -3.3e9,
+            1.0e20,
+            f32::MAX,
+            f32::MIN,
+            2.0e38,
+            8.0e6,
+            -8.0e6,
+        ] {
+            let (s, c) = sin_cos(x);
+            assert!(s.abs() <= 1.0 && c.abs() <= 1.0, "sin_cos({x}) = {s}, {c}");
+        }
+        for x in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            let (s, c) = sin_cos(x);
+            assert!(s.is_nan() && c.is_nan());
+        }
     }
 
     #[test]

@@ -219,6 +219,7 @@ impl<R: WSpan> Rasterizer<R> {
             p,
             area: area.unsigned_abs() as i128,
             i_ref: (xmin >> SUBPIXEL_BITS) as i64,
+            j_ref: j_first,
             j0,
         };
         let t_or = order.map(|k| s.t[k]);
@@ -283,14 +284,13 @@ impl<R: SpanRecip> Rasterizer<R> {
 
     /// Draws one flat-coloured triangle (the colour of its first vertex) into a W16 buffer: the lean path.
     /// On an error nothing is written, except for a failing `target` ([`Error::Target`] says what is left).
-    pub fn draw<D, V>(
+    pub fn draw<D>(
         &mut self,
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
-        v: &[V; 3],
+        v: &[impl VertexInput<Color = D::Color>; 3],
     ) -> Result<Stats, Error>
     where
-        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor,
     {
@@ -335,14 +335,13 @@ impl<R: SpanRecip> Rasterizer<R> {
     /// channel `c` is carried as the plane of `c * t` (linear in screen space) and divided per pixel by `t` with the
     /// same reciprocal as the depth, then rounded to 8 bits. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
     #[cfg(feature = "gouraud")]
-    pub fn draw_gouraud<D, V>(
+    pub fn draw_gouraud<D>(
         &mut self,
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
-        v: &[V; 3],
+        v: &[impl VertexInput<Color = D::Color>; 3],
     ) -> Result<Stats, Error>
     where
-        V: VertexInput<Color = D::Color>,
         D: DrawTarget,
         D::Color: PixelColor + From<Rgb888> + Into<Rgb888>,
     {
@@ -430,11 +429,18 @@ impl<R: SpanRecip> Rasterizer<R> {
     }
 }
 
-/// Positions of the oriented triangle and the reference pixel of its planes: column `i_ref`, row `j0`.
+/// Positions of the oriented triangle, the reference pixel of its planes (column `i_ref`, row `j_ref`: the box's
+/// left column and the triangle's first row, whatever the buffer), and the first row walked, `j0`.
+///
+/// The planes are rounded at the reference pixel and stepped from there to `j0` with their rounded row step, so a
+/// pixel's value does not depend on which band (or buffer) walks it: a frame drawn in bands equals the frame drawn
+/// whole, codes and range tests included. (A fuzz finding: with the planes rounded at each band's first row, pixels
+/// exactly on the near plane flipped between bands.)
 pub(crate) struct Geom {
     pub(crate) p: [Sub; 3],
     pub(crate) area: i128,
     pub(crate) i_ref: i64,
+    pub(crate) j_ref: i32,
     pub(crate) j0: i32,
 }
 
@@ -456,13 +462,22 @@ impl Plane {
         let gy = d2 * (p1.x - p0.x) as i128 - d1 * (p2.x - p0.x) as i128;
         let (rx, ry) = (
             256 * g.i_ref as i128 + 128 - p0.x as i128,
-            256 * g.j0 as i128 + 128 - p0.y as i128,
+            256 * g.j_ref as i128 + 128 - p0.y as i128,
         );
         Plane {
             row: (v[0] as i128 + div_round(gx * rx + gy * ry, g.area)) as i64,
             sx: div_round(gx * 256, g.area) as i64,
             sy: div_round(gy * 256, g.area) as i64,
         }
+        .at_row(g)
+    }
+    /// From the reference row to the first row walked, by whole row steps (what walking there would give).
+    #[inline]
+    fn at_row(mut self, g: &Geom) -> Plane {
+        self.row = self
+            .row
+            .wrapping_add(self.sy.wrapping_mul((g.j0 - g.j_ref) as i64));
+        self
     }
     /// The fast tier's plane of `T` for a small triangle (box under 127 px), from one 64-bit reciprocal of the
     /// doubled area instead of three exact 128-bit divisions; `None` where its error bound does not hold (then the
@@ -500,13 +515,16 @@ impl Plane {
         let step = |g: i64| ((g as i128 * inv as i128) >> 38) as i64;
         let (sx, sy) = (step(gx), step(gy));
         let rx = 256 * g.i_ref + 128 - p0.x as i64;
-        let ry = 256 * g.j0 as i64 + 128 - p0.y as i64;
+        let ry = 256 * g.j_ref as i64 + 128 - p0.y as i64;
         let off = (sx as i128 * rx as i128 + sy as i128 * ry as i128) >> 8;
-        Some(Plane {
-            row: (tp[0] << 16).wrapping_add(off as i64),
-            sx,
-            sy,
-        })
+        Some(
+            Plane {
+                row: (tp[0] << 16).wrapping_add(off as i64),
+                sx,
+                sy,
+            }
+            .at_row(g),
+        )
     }
 
     #[inline(always)]
