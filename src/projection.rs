@@ -161,7 +161,8 @@ impl Mat4 {
     /// right-handed world (the usual one: a mesh wound counter-clockwise seen from outside shows its front faces
     /// counter-clockwise on screen, and [`Cull::Cw`](crate::Cull::Cw) drops the back faces).
     /// [`Error::InvalidCamera`] when `eye == target` or `up` is parallel to the view direction; [`Error::NonFinite`]
-    /// for a NaN or an infinity.
+    /// for a NaN or an infinity; [`Error::WorldTooLarge`] when the eye is so far out (near `f32::MAX`) that the
+    /// translation overflows f32.
     pub fn look_at(eye: [f32; 3], target: [f32; 3], up: [f32; 3]) -> Result<Mat4, Error> {
         if !eye.iter().chain(&target).chain(&up).all(|v| v.is_finite()) {
             return Err(Error::NonFinite);
@@ -169,11 +170,16 @@ impl Mat4 {
         let f = unit(sub3(target, eye)).ok_or(Error::InvalidCamera)?;
         let r = unit(cross3(f, up)).ok_or(Error::InvalidCamera)?;
         let u = cross3(r, f);
+        let t = [-dot3(eye, r), -dot3(eye, u), -dot3(eye, f)];
+        // (A fuzz finding: an eye at 3e38 gave an infinite translation.)
+        if !t.iter().all(|v| v.is_finite()) {
+            return Err(Error::WorldTooLarge);
+        }
         Ok(Mat4([
             [r[0], u[0], f[0], 0.0],
             [r[1], u[1], f[1], 0.0],
             [r[2], u[2], f[2], 0.0],
-            [-dot3(eye, r), -dot3(eye, u), -dot3(eye, f), 1.0],
+            [t[0], t[1], t[2], 1.0],
         ]))
     }
 }

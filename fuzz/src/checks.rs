@@ -6,7 +6,7 @@
 //! codes, fragments and written counts, and the same error for the same call); a failing colour target gives
 //! [`Error::Target`] and no other error than the whole draw gives.
 
-use crate::{Bytes, Canvas, Guarded};
+use super::{Bytes, Canvas, Guarded};
 use embedded_graphics_core::pixelcolor::Rgb565;
 use wraster::clip::Viewport;
 use wraster::format::{W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
