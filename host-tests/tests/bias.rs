@@ -122,3 +122,60 @@ fn bias_removes_coplanar_fighting_without_gaps() {
     let (covered, shown) = visible(constant, 1.0 / 1.02);
     assert_eq!(shown, 0, "{shown} of {covered} pixels bled through");
 }
+
+/// The offset's value, not only its sufficiency: a triangle whose vertex codes change by 3 codes a pixel across and
+/// 1.5 down (so `max(|gx|, |gy|) = 3`, while `|gx| + |gy| = 4.5`) stores, at every pixel, its unbiased code plus
+/// `round(m * SLOPESCALEDEPTHBIAS + DEPTHBIAS)`: 3 for (1, 0), 5 for (2, -1.25) (4.75), -2 for (0, -2.4). A slope
+/// term taken as the sum (4.5 -> 5, 9 - 1.25 -> 8) or scaled wrongly moves every code. The slope is taken from the
+/// vertices' codes in f32 (src/raster.rs), exact to about 2^-20 of a code here, far from the .5 ties these land on.
+#[test]
+fn bias_offset_is_max_slope_times_scale_plus_constant() {
+    // Codes c = 65535 W / W_far at pixel centres (0.5, 0.5), (40.5, 0.5), (0.5, 30.5): c0 + 3 x + 1.5 y. W is
+    // not affine in screen space, but the bias's m is defined from the three vertices' codes (the plane through
+    // them), which is what this sets.
+    let c0 = 20_000.0f64;
+    let code = |x: f64, y: f64| c0 + 3.0 * (x - 0.5) + 1.5 * (y - 0.5);
+    let v = |x: f32, y: f32| Vertex {
+        x,
+        y,
+        z: 0.5,
+        rhw: (65535.0 / (code(x as f64, y as f64) * FAR as f64)) as f32,
+        color: Rgb565::WHITE,
+    };
+    let t = [v(0.5, 0.5), v(40.5, 0.5), v(0.5, 30.5)];
+    let draw = |slope: f32, constant: f32| {
+        let mut state = RenderState::new(1.0, FAR).unwrap();
+        state.compare = Compare::Always;
+        state.slope_scale_depth_bias = slope;
+        state.depth_bias = constant;
+        let mut depth = vec![0u16; W as usize * H as usize];
+        let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
+        buf.clear();
+        let s = Rasterizer::<wraster::recip::Fast>::new(state)
+            .draw(&mut Frame::new(W as u32, H as u32), &mut buf, &t)
+            .unwrap();
+        assert!(s.written > 500);
+        depth
+    };
+    let base = draw(0.0, 0.0);
+    for (slope, constant, offset) in [
+        (1.0, 0.0, 3),
+        (2.0, -1.25, 5),
+        (0.0, -2.4, -2),
+        (0.5, 0.0, 2),
+    ] {
+        let got = draw(slope, constant);
+        let mut n = 0;
+        for (k, (&g, &b)) in got.iter().zip(&base).enumerate() {
+            if b != wraster::W16_FAR {
+                assert_eq!(
+                    g as i32 - b as i32,
+                    offset,
+                    "pixel {k}, slope {slope}, constant {constant}"
+                );
+                n += 1;
+            }
+        }
+        assert!(n > 500);
+    }
+}

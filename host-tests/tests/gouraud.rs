@@ -58,7 +58,8 @@ fn gouraud_is_perspective_correct() {
             *q = Vertex::new(
                 rng.f(-30.0, 126.0) as f32,
                 rng.f(-30.0, 94.0) as f32,
-                rng.log(1.0, 1000.0) as f32,
+                // vertices in and out of the depth range [1, 1000], so the range test decides some pixels
+                rng.log(0.6, 1600.0) as f32,
                 Rgb888::new(
                     (rng.bits() % 256) as u8,
                     (rng.bits() % 256) as u8,
@@ -76,6 +77,10 @@ fn gouraud_is_perspective_correct() {
         let Some(pixels) = reference_tri(&pts, 1.0, 1000.0, W as i32, 0..H as i32) else {
             continue;
         };
+        // Two-sided: exactly the reference's in-range pixels are drawn (each covered pixel checked below, and
+        // nothing else: the counts agree), so a lost range test or extra coverage fails.
+        let drawn = frame.px.iter().filter(|p| p.is_some()).count();
+        assert_eq!(drawn, pixels.iter().filter(|p| p.in_range).count(), "{v:?}");
         for p in pixels.iter().filter(|p| p.in_range) {
             let got =
                 frame.px[p.y as usize * W as usize + p.x as usize].expect("covered pixel drawn");
