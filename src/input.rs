@@ -73,6 +73,39 @@ impl<C: Copy> VertexInput for Vertex<C> {
 ///
 /// Ranges, checked at the draw: `|x|, |y| <` [`GUARD_BAND`] (else [`Error::OutOfGuardBand`]), `rhw > 0` (else
 /// [`Error::RhwNotPositive`]), `rhw * W_far` below [`crate::MAX_T`] (else [`Error::DepthRange`]).
+///
+/// ```
+/// use embedded_graphics_core::pixelcolor::Rgb565;
+/// use embedded_graphics_core::prelude::*;
+/// use wraster::input::{I24F8, U1F31};
+/// use wraster::{DepthStore, FixedVertex, Rasterizer, RenderState, Vertex};
+///
+/// # struct Screen;
+/// # impl OriginDimensions for Screen { fn size(&self) -> Size { Size::new(32, 16) } }
+/// # impl DrawTarget for Screen {
+/// #     type Color = Rgb565; type Error = core::convert::Infallible;
+/// #     fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(&mut self, _: I) -> Result<(), Self::Error> { Ok(()) }
+/// # }
+/// // x, y on the 16.8 grid and 1/W as integers: a core without an FPU never touches a float.
+/// let v = |x: i32, y: i32, rhw_bits: u32| FixedVertex {
+///     x: I24F8::from_bits(x << 8 | 128), // pixel centre x + 0.5
+///     y: I24F8::from_bits(y << 8 | 128),
+///     rhw: U1F31::from_bits(rhw_bits), // 1/W = bits / 2^31
+///     color: Rgb565::RED,
+/// };
+/// let tri = [v(1, 1, 1 << 26), v(30, 4, 1 << 22), v(6, 14, 1 << 24)]; // W = 32, 512, 128
+/// let mut r: Rasterizer = Rasterizer::new(RenderState::new(10.0, 1000.0)?);
+/// let mut depth = DepthStore::<32, 16>::new();
+/// let fixed = r.draw(&mut Screen, &mut depth.view(), &tri)?;
+///
+/// // The f32 twin (the same values) draws the same pixels with the same codes.
+/// let mut twin = DepthStore::<32, 16>::new();
+/// let f = tri.map(|q| Vertex::new(q.x.to_num(), q.y.to_num(), 1.0 / q.rhw.to_num::<f32>(), q.color));
+/// assert_eq!(r.draw(&mut Screen, &mut twin.view(), &f)?, fixed);
+/// assert_eq!(depth.view().data(), twin.view().data());
+/// assert!(fixed.written > 100);
+/// # Ok::<(), wraster::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FixedVertex<C, R = U1F31> {
     /// Pixels, right.
