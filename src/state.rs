@@ -128,9 +128,13 @@ impl DepthRange {
         self.far
     }
     /// `floor(far / near * 2^frac)`: the largest `T = t * 2^frac` still at or beyond the near plane.
+    /// Saturates at `i64::MAX`, not `u64::MAX`: a plane value is an `i64` (below `2^62` where it is meaningful), and a
+    /// rounding just below zero (a vertex `t` that rounds to 0, `W` beyond `2^61 W_far`) wraps to a `u64` above
+    /// `i64::MAX`, which the range test must refuse. (A fuzz finding: with `2^frac W_far / W_near` above `2^64` the
+    /// bound saturated at `u64::MAX` and let such a span into the fast loop, whose shift overflowed.)
     pub(crate) fn t_max(&self, frac: u32) -> u64 {
         let q = self.t_max_q >> (TMAX_FRAC - frac.min(TMAX_FRAC));
-        q.min(u64::MAX as u128) as u64
+        q.min(i64::MAX as u128) as u64
     }
 }
 
