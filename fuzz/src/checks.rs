@@ -190,6 +190,8 @@ fn raster_with<R: SpanRecip>(b: &mut Bytes) {
     let mut depth = Guarded::new(n, 0u16, 0xa5a5);
     DepthBuffer::new(depth.inner(), w, h).unwrap().clear();
     let mut whole = Vec::new();
+    // The whole run's colour and depth after each call (index k + 1), for the failing target's documented state.
+    let mut states = vec![(canvas.clone(), depth.data().to_vec())];
     for (g, t) in &ops {
         let (c0, d0) = (canvas.clone(), depth.data().to_vec());
         let res = draw(
@@ -207,6 +209,7 @@ fn raster_with<R: SpanRecip>(b: &mut Bytes) {
             }
         }
         whole.push(res);
+        states.push((canvas.clone(), depth.data().to_vec()));
     }
 
     let mut canvas2 = Canvas::new(w as u32, h as u32);
@@ -231,17 +234,40 @@ fn raster_with<R: SpanRecip>(b: &mut Bytes) {
     canvas3.budget = Some(b.u16() as u32 % 512);
     let mut depth3 = Guarded::new(n, 0u16, 0x5a5a);
     DepthBuffer::new(depth3.inner(), w, h).unwrap().clear();
+    let mut failed_at = None;
     failing_matches(&whole, |k| {
         let (g, t) = &ops[k];
-        draw(
+        let res = draw(
             &mut r,
             &mut canvas3,
             &mut DepthBuffer::new(depth3.inner(), w, h).unwrap(),
             *g,
             t,
-        )
+        );
+        if res == Err(Error::Target) {
+            failed_at = Some(k);
+        }
+        res
     });
     depth3.check();
+    if let Some(k) = failed_at {
+        // Error::Target's documented state: every row above the failing one as the whole draw left it (colour and
+        // depth), the failing row partly, every later row as it was before the call.
+        let (before, after) = (&states[k], &states[k + 1]);
+        let cols = |j: usize| j * w as usize..(j + 1) * w as usize;
+        let same_as = |st: &(Canvas, Vec<u16>), j: usize| {
+            canvas3.px[cols(j)] == st.0.px[cols(j)] && depth3.data()[cols(j)] == st.1[cols(j)]
+        };
+        let jf = (0..h as usize)
+            .find(|&j| !same_as(after, j))
+            .unwrap_or(h as usize);
+        for j in jf + 1..h as usize {
+            assert!(
+                same_as(before, j),
+                "row {j}, after the failing row {jf}, was touched"
+            );
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
