@@ -15,9 +15,12 @@
 //! row walk skips horizontal edges.
 //!
 //! Ranges: with vertices inside the guard band (`|x|, |y| < 2^20` sub-pixels) `|A|, |B| < 2^21`, `|C| < 2^42`, and
-//! `|N| < 2^44`: the set-up runs in `i64` (see ARCHITECTURE.md). What it leaves fits `i32`: the quotient `q` is a
-//! column bound of a row the triangle spans, so inside the guard band (`|q| <= 2^12 + 1`); `0 <= r < D = 256 |A| < 2^29`;
-//! `|floor(256 B / D)| < 2^21`. So the walk per row is 32-bit.
+//! `|N| < 2^44`: the set-up runs in `i64` (see ARCHITECTURE.md). The remainder walk is 32-bit:
+//! `0 <= r < D = 256 |A| < 2^29`, `|floor(256 B / D)| < 2^21`. The quotient `q` is not: it is the column where the
+//! edge's line crosses the row, and a nearly horizontal edge (`|A|` of a few sub-pixels, `|B|` up to `2^21`) crosses
+//! rows a few pixels away at up to `2^21` px a row, `|q|` up to `2^36` over the triangle's rows (a fuzz finding: an
+//! `i32` quotient overflowed there, and would have wrapped on the boards). So `q` is an `i64` (one add with carry
+//! more per edge and row) and [`Edge::bound`] clamps it to `+-2^30` columns, beyond any buffer.
 
 /// A sub-pixel position.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,10 +41,10 @@ pub(crate) enum Side {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Edge {
     pub side: Side,
-    q: i32,
+    q: i64,
     r: i32,
     d: i32,
-    step_q: i32,
+    step_q: i64,
     step_r: i32,
 }
 
@@ -69,10 +72,10 @@ impl Edge {
         let d = 256 * a_.abs();
         Edge {
             side: if a_ > 0 { Side::Left } else { Side::Right },
-            q: n.div_euclid(d) as i32,
+            q: n.div_euclid(d),
             r: n.rem_euclid(d) as i32,
             d: d as i32,
-            step_q: s.div_euclid(d) as i32,
+            step_q: s.div_euclid(d),
             step_r: s.rem_euclid(d) as i32,
         }
     }
@@ -101,10 +104,10 @@ impl Edge {
         let q = n.div_euclid(d);
         Edge {
             side: if a_ > 0 { Side::Left } else { Side::Right },
-            q: if a_ > 0 { q - ox } else { q + ox },
+            q: (if a_ > 0 { q - ox } else { q + ox }) as i64,
             r: n.rem_euclid(d),
             d,
-            step_q: s.div_euclid(d),
+            step_q: s.div_euclid(d) as i64,
             step_r: s.rem_euclid(d),
         }
     }
@@ -123,9 +126,11 @@ impl Edge {
     /// The bound this edge puts on the current row, as a half-open column range `[lo, hi)`.
     #[inline(always)]
     pub fn bound(&self) -> (i32, i32) {
+        const FAR: i64 = 1 << 30;
+        let q = self.q.clamp(-FAR, FAR) as i32;
         match self.side {
-            Side::Left => (-self.q, i32::MAX),
-            Side::Right => (i32::MIN, self.q + 1),
+            Side::Left => (-q, i32::MAX),
+            Side::Right => (i32::MIN, q + 1),
             Side::Flat => (i32::MIN, i32::MAX),
         }
     }

@@ -13,7 +13,7 @@ pub enum Error {
     RhwNotPositive,
     /// A vertex x or y outside the guard band `[-GUARD_BAND, GUARD_BAND]` pixels.
     OutOfGuardBand,
-    /// `rhw * W_far` of a vertex is above [`crate::MAX_T`] (the vertex is more than `MAX_T` times nearer than the far plane).
+    /// `rhw * W_far` of a vertex is at or above [`crate::MAX_T`] (the vertex is `MAX_T` times nearer than the far plane, or more).
     DepthRange,
     /// `W_near <= 0`, `W_far <= W_near`, or `W_far / W_near` above [`crate::MAX_T`].
     InvalidDepthRange,

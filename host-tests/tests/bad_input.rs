@@ -253,3 +253,39 @@ fn a_failing_target_leaves_whole_rows_and_a_prefix() {
         );
     }
 }
+
+/// `MAX_T` is the limit the checks apply (a mutation of the constant went unnoticed: nothing compared it with the
+/// checks): a far/near ratio of exactly `MAX_T` is accepted and the next f32 above it refused; a vertex's
+/// `rhw * W_far` must stay below it (the plane keeps 31 integer bits): just below is accepted, exactly `MAX_T` refused.
+#[test]
+fn max_t_is_the_limit_the_checks_apply() {
+    assert_eq!(wraster::MAX_T, 1073741824.0);
+    assert!(DepthRange::new(1.0, wraster::MAX_T).is_ok());
+    let above = f32::from_bits(wraster::MAX_T.to_bits() + 1);
+    assert_eq!(DepthRange::new(1.0, above), Err(Error::InvalidDepthRange));
+    let mut r: Rasterizer = Rasterizer::new(RenderState::new(1.0, 1024.0).unwrap());
+    let mut store = DepthStore::<64, 48>::new();
+    let v = |rhw: f32| Vertex {
+        x: 10.0,
+        y: 10.0,
+        z: 0.0,
+        rhw,
+        color: Rgb565::RED,
+    };
+    let tri = |rhw| {
+        [
+            v(rhw),
+            Vertex { x: 40.0, ..v(0.01) },
+            Vertex { y: 40.0, ..v(0.01) },
+        ]
+    };
+    // rhw * W_far just below MAX_T: accepted (that vertex is nearer than W_near, so it is clipped per pixel)
+    let below = f32::from_bits(1048576.0f32.to_bits() - 1);
+    assert!(r
+        .draw(&mut Frame::new(64, 48), &mut store.view(), &tri(below))
+        .is_ok());
+    assert_eq!(
+        r.draw(&mut Frame::new(64, 48), &mut store.view(), &tri(1048576.0)),
+        Err(Error::DepthRange)
+    );
+}
