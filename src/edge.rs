@@ -15,12 +15,16 @@
 //! row walk skips horizontal edges.
 //!
 //! Ranges: with vertices inside the guard band (`|x|, |y| < 2^20` sub-pixels) `|A|, |B| < 2^21`, `|C| < 2^42`, and
-//! `|N| < 2^44`: the set-up runs in `i64` (see ARCHITECTURE.md). The remainder walk is 32-bit:
-//! `0 <= r < D = 256 |A| < 2^29`, `|floor(256 B / D)| < 2^21`. The quotient `q` is not: it is the column where the
-//! edge's line crosses the row, and a nearly horizontal edge (`|A|` of a few sub-pixels, `|B|` up to `2^21`) crosses
-//! rows a few pixels away at up to `2^21` px a row, `|q|` up to `2^36` over the triangle's rows (a fuzz finding: an
-//! `i32` quotient overflowed there, and would have wrapped on the boards). So `q` is an `i64` (one add with carry
-//! more per edge and row) and [`Edge::bound`] clamps it to `+-2^30` columns, beyond any buffer.
+//! `|N| < 2^44`: the set-up runs in `i64` (see ARCHITECTURE.md). The walk per row is 32-bit:
+//! `0 <= r < D = 256 |A| < 2^29`, `|floor(256 B / D)| < 2^21`, and the quotient `q`, the column where the edge's line
+//! crosses the row, is kept within `i32` as follows. A nearly horizontal edge (`|A|` a few sub-pixels) crosses rows
+//! a few pixels away at up to `2^21` px a row, so over the triangle's rows `|q|` reaches `2^36` (a fuzz finding: the
+//! `i32` quotient overflowed there). But wherever `|q|` is beyond the guard band the edge does not bind: the triangle
+//! spans the row, inside the edge's half-plane, so the line crosses the row beyond the triangle, on the far side.
+//! So the set-up clamps `q` to `+-2^30` (the same side, as far as matters), and the walk sets the edges up again
+//! every [`Edge::rows_exact`] rows, few enough (`K (|step| + 1) <= 2^29`) that `q` neither overflows nor, when it
+//! started clamped, comes back within `2^29` of the frame: within a stretch, an exact `q` stays exact, a clamped one
+//! stays beyond the guard band.
 
 /// A sub-pixel position.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,10 +45,10 @@ pub(crate) enum Side {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Edge {
     pub side: Side,
-    q: i64,
+    q: i32,
     r: i32,
     d: i32,
-    step_q: i64,
+    step_q: i32,
     step_r: i32,
 }
 
@@ -70,12 +74,13 @@ impl Edge {
         let n = a_ * (128 - a.x as i64) + b_ * (256 * j as i64 + 128 - a.y as i64) - bias;
         let s = 256 * b_;
         let d = 256 * a_.abs();
+        const FAR: i64 = 1 << 30;
         Edge {
             side: if a_ > 0 { Side::Left } else { Side::Right },
-            q: n.div_euclid(d),
+            q: n.div_euclid(d).clamp(-FAR, FAR) as i32,
             r: n.rem_euclid(d) as i32,
             d: d as i32,
-            step_q: s.div_euclid(d),
+            step_q: s.div_euclid(d) as i32,
             step_r: s.rem_euclid(d) as i32,
         }
     }
@@ -104,12 +109,19 @@ impl Edge {
         let q = n.div_euclid(d);
         Edge {
             side: if a_ > 0 { Side::Left } else { Side::Right },
-            q: (if a_ > 0 { q - ox } else { q + ox }) as i64,
+            q: if a_ > 0 { q - ox } else { q + ox },
             r: n.rem_euclid(d),
             d,
-            step_q: s.div_euclid(d) as i64,
+            step_q: s.div_euclid(d),
             step_r: s.rem_euclid(d),
         }
+    }
+
+    /// How many rows the walk may step from a set-up before `q` could leave the range the module doc allows:
+    /// a power of two `K` with `K (|step_q| + 1) <= 2^29` (at least 128, as `|step_q| < 2^21`).
+    pub fn rows_exact(&self) -> i32 {
+        let m = self.step_q.unsigned_abs() + 1;
+        1 << (29 - (32 - m.leading_zeros())).min(24)
     }
 
     /// Moves to the next row.
@@ -126,11 +138,9 @@ impl Edge {
     /// The bound this edge puts on the current row, as a half-open column range `[lo, hi)`.
     #[inline(always)]
     pub fn bound(&self) -> (i32, i32) {
-        const FAR: i64 = 1 << 30;
-        let q = self.q.clamp(-FAR, FAR) as i32;
         match self.side {
-            Side::Left => (-q, i32::MAX),
-            Side::Right => (i32::MIN, q + 1),
+            Side::Left => (-self.q, i32::MAX),
+            Side::Right => (i32::MIN, self.q + 1),
             Side::Flat => (i32::MIN, i32::MAX),
         }
     }

@@ -252,10 +252,14 @@ impl<R: WSpan> Rasterizer<R> {
                 Edge::new(p[2], p[0], j0),
             ]
         };
+        let exact = edges.iter().map(Edge::rows_exact).min().unwrap_or(1 << 24);
         Ok(Ok(Walk {
             frac: s.frac,
             t_vertex: t_or,
             edges,
+            j: j0,
+            exact,
+            left: exact,
             geom,
             order,
             j1,
@@ -544,6 +548,10 @@ pub(crate) struct Walk {
     /// The vertices' `T`, in oriented order.
     pub(crate) t_vertex: [i64; 3],
     edges: [Edge; 3],
+    /// The current row, the rows between edge set-ups ([`Edge::rows_exact`]) and the rows left until the next.
+    j: i32,
+    exact: i32,
+    left: i32,
     pub(crate) geom: Geom,
     /// Vertex order after orientation.
     #[cfg_attr(not(feature = "gouraud"), allow(dead_code))]
@@ -571,6 +579,23 @@ impl Walk {
             e.step();
         }
         self.t.next_row();
+        self.j += 1;
+        self.left -= 1;
+        if self.left == 0 {
+            self.reset_edges();
+        }
+    }
+    /// The edges set up again at the current row (exactly, from the snapped vertices), every `exact` rows: only
+    /// triangles with a nearly horizontal edge and hundreds of rows get here (see `crate::edge`).
+    #[inline(never)]
+    fn reset_edges(&mut self) {
+        let p = self.geom.p;
+        self.edges = [
+            Edge::new(p[0], p[1], self.j),
+            Edge::new(p[1], p[2], self.j),
+            Edge::new(p[2], p[0], self.j),
+        ];
+        self.left = self.exact;
     }
 }
 

@@ -49,9 +49,9 @@ fn state(b: &mut Bytes) -> RenderState {
     };
     s.mode = [DepthMode::W, DepthMode::Z, DepthMode::Off][b.u8() as usize % 3];
     s.compare = COMPARES[b.u8() as usize % 8];
-    s.depth_write = b.u8() % 4 != 0;
+    s.depth_write = !b.u8().is_multiple_of(4);
     s.cull = [Cull::None, Cull::Cw, Cull::Ccw][b.u8() as usize % 3];
-    if b.u8() % 4 == 0 {
+    if b.u8().is_multiple_of(4) {
         s.depth_bias = b.f32();
         s.slope_scale_depth_bias = b.f32();
     }
@@ -62,7 +62,11 @@ fn vertex(b: &mut Bytes) -> Vertex<Rgb565> {
     Vertex {
         x: b.f32(),
         y: b.f32(),
-        z: if b.u8() % 8 == 0 { b.f32() } else { 0.0 },
+        z: if b.u8().is_multiple_of(8) {
+            b.f32()
+        } else {
+            0.0
+        },
         rhw: b.f32(),
         color: b.color(),
     }
@@ -152,7 +156,7 @@ fn raster_with<R: SpanRecip>(b: &mut Bytes) {
     let n = (w as usize) * (h as usize);
     let st = state(b);
     let ops: Vec<(bool, [Vertex<Rgb565>; 3])> = (0..1 + b.u8() % 6)
-        .map(|_| (b.u8() % 4 == 0, [vertex(b), vertex(b), vertex(b)]))
+        .map(|_| (b.u8().is_multiple_of(4), [vertex(b), vertex(b), vertex(b)]))
         .collect();
     // A wrong-size buffer is refused.
     let off = b.u8() as usize % 5;
@@ -311,7 +315,7 @@ fn packed_with<F: Codec, R: WSpan>(b: &mut Bytes) {
     let (w, h, band) = dims(b);
     let n = (w as usize) * (h as usize);
     let st = state(b);
-    let no_depth = b.u8() % 8 == 0;
+    let no_depth = b.u8().is_multiple_of(8);
     let ops: Vec<(Prim, [Vertex<Rgb565>; 3])> = (0..1 + b.u8() % 6)
         .map(|_| {
             let p = [Prim::Tri, Prim::Line, Prim::Point, Prim::Wire][b.u8() as usize % 4];
@@ -656,7 +660,7 @@ pub fn state_target(data: &[u8]) {
     match DepthRange::new(near, far) {
         Ok(r) => {
             assert!(r.near() > 0.0 && r.far() > r.near() && r.far().is_finite());
-            assert!((r.far() / r.near()) <= wraster::MAX_T as f32 * 1.0001);
+            assert!((r.far() / r.near()) <= wraster::MAX_T * 1.0001);
             assert_eq!(RenderState::new(near, far).map(|s| s.range), Ok(r));
         }
         Err(e) => {
@@ -763,7 +767,7 @@ fn fixed_twin<R: wraster::input::Fixed<Bits = u32>>(
     // x, y: any 16.8 value within the guard band, or any bits at all.
     let mut xy = || {
         let v = b.u32() as i32;
-        if b.u8() % 8 == 0 {
+        if b.u8().is_multiple_of(8) {
             v
         } else {
             v % (4096 << 8)
@@ -771,7 +775,7 @@ fn fixed_twin<R: wraster::input::Fixed<Bits = u32>>(
     };
     let (x, y) = (I24F8::from_bits(xy()), I24F8::from_bits(xy()));
     let mut bits = b.u32();
-    let full = b.u8() % 4 == 0;
+    let full = b.u8().is_multiple_of(4);
     if !full {
         // at most 24 significant bits, so the value is an f32 too
         let sig = 32 - bits.leading_zeros();

@@ -45,14 +45,14 @@ fn twins(v: Vertex<Rgb565>) -> (Vertex<Rgb565>, FixedVertex<Rgb565>) {
     )
 }
 
+/// A triangle as f32 vertices and as their fixed-point twins.
+type Pair = ([Vertex<Rgb565>; 3], [FixedVertex<Rgb565>; 3]);
+
 const W: u16 = 96;
 const H: u16 = 64;
 
 /// Each pair drawn alone into cleared buffers (so no later triangle hides a difference), flat and Gouraud.
-fn w16_pair<R: SpanRecip>(
-    tris: &[([Vertex<Rgb565>; 3], [FixedVertex<Rgb565>; 3])],
-    state: RenderState,
-) {
+fn w16_pair<R: SpanRecip>(tris: &[Pair], state: RenderState) {
     let mut r = Rasterizer::<R>::new(state);
     let n = W as usize * H as usize;
     let (mut da, mut db) = (vec![0u16; n], vec![0u16; n]);
@@ -86,7 +86,7 @@ fn w16_pair<R: SpanRecip>(
     assert!(written > 100_000, "the suite must draw: {written}");
 }
 
-fn suite() -> Vec<([Vertex<Rgb565>; 3], [FixedVertex<Rgb565>; 3])> {
+fn suite() -> Vec<Pair> {
     let mut rng = Rng(77);
     (0..3000)
         .map(|_| {
@@ -137,7 +137,7 @@ fn fixed_input_draws_like_f32_in_packed_formats_and_primitives() {
                 let x = r.draw_format(&mut fa, Some(&mut qa), a);
                 let y = r.draw_format(&mut fb, Some(&mut qb), b);
                 assert_eq!(x, y);
-                drop((qa, qb));
+                let _ = (qa, qb);
                 let diff = za.iter().zip(&zb).filter(|(p, q)| p != q).count();
                 assert!(diff == 0, "{diff} bytes differ: {a:?} / {b:?} {x:?}");
                 total += x.map(|s| s.written).unwrap_or(0);
@@ -163,7 +163,7 @@ fn fixed_input_draws_like_f32_in_packed_formats_and_primitives() {
                 r.draw_wireframe_format(&mut fa, Some(&mut pa), a),
                 r.draw_wireframe_format(&mut fb, Some(&mut pb), b)
             );
-            drop((pa, pb));
+            let _ = (pa, pb);
             assert!(ba == bb, "codes differ: {a:?} / {b:?}");
         }
         assert!(total > 20_000, "{mode:?}: {total}");

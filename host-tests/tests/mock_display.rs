@@ -135,7 +135,7 @@ fn grid_of_adjoining_triangles_covers_each_pixel_once() {
     for j in 0..ny {
         for i in 0..nx {
             let (a, b, c, d) = (v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1));
-            let tris = if rng.bits() % 2 == 0 {
+            let tris = if rng.bits().is_multiple_of(2) {
                 [[a, b, c], [a, c, d]]
             } else {
                 [[a, b, d], [b, c, d]]
