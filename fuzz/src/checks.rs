@@ -453,7 +453,10 @@ pub fn world(data: &[u8]) {
                 assert!(
                     matches!(
                         e,
-                        Error::InvalidCamera | Error::NonFinite | Error::InvalidDepthRange
+                        Error::InvalidCamera
+                            | Error::NonFinite
+                            | Error::InvalidDepthRange
+                            | Error::WorldTooLarge
                     ),
                     "{e:?}"
                 );
