@@ -169,7 +169,23 @@ impl Planes {
         let rhw = 1.0 / w;
         let x = (self.ox + c[0] * rhw * self.sx).clamp(-CLIP_BAND, CLIP_BAND);
         let y = (self.oy - c[1] * rhw * self.sy).clamp(-CLIP_BAND, CLIP_BAND);
-        [x, y, self.zmin + c[2] * rhw * self.zscale, rhw]
+        // z is only checked downstream (depth comes from rhw): an overflow there must not refuse the vertex.
+        let z = self.zmin + c[2] * rhw * self.zscale;
+        [x, y, if z.is_finite() { z } else { 0.0 }, rhw]
+    }
+
+    /// [`Planes::map`], refused with [`Error::WorldTooLarge`] when the result is not a drawable vertex: a NaN `x` or
+    /// `y`, or `rhw` not finite and positive (`1 / w` overflows for a `W_near` below about `3e-39`). (A fuzz finding:
+    /// a clipped vertex's interpolated coordinates could overflow after the last plane, and reach the draw as a
+    /// non-finite vertex after earlier triangles of the mesh had been drawn.)
+    #[inline]
+    pub(crate) fn map_checked(&self, c: &[f32]) -> Result<[f32; 4], Error> {
+        let v = self.map(c);
+        if v[0].is_nan() || v[1].is_nan() || !(v[3].is_finite() && v[3] > 0.0) || !c[3].is_finite()
+        {
+            return Err(Error::WorldTooLarge);
+        }
+        Ok(v)
     }
 
     /// Clips triangle `c` (clip space) against the five planes (Sutherland-Hodgman), `out` the triangle's outcodes
@@ -206,6 +222,10 @@ impl Planes {
                 return Ok(Poly::new());
             }
             poly = next;
+        }
+        // Every vertex must map to a drawable one (an interpolation after the last plane can overflow).
+        for v in poly.iter() {
+            self.map_checked(v)?;
         }
         Ok(poly)
     }

@@ -179,6 +179,8 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
                 stats.culled += 1;
                 continue;
             }
+            // A triangle whose clipping overflows f32 is skipped here (draw_world reports it as WorldTooLarge):
+            // the draws of a transformed frame do not fail on input.
             let Ok(poly) = self.planes.clip(&cl, codes[0] | codes[1] | codes[2]) else {
                 continue;
             };
@@ -243,7 +245,7 @@ impl<R: WSpan> Rasterizer<R> {
         for (p, s) in mesh.positions.iter().zip(scratch.iter_mut()) {
             let c = to_clip(m, p)?;
             *s = if planes.outcode(&c) == 0 {
-                let [x, y, _, rhw] = planes.map(&c);
+                let [x, y, _, rhw] = planes.map_checked(&c)?;
                 Projected { x, y, rhw }
             } else {
                 Projected::default()

@@ -540,6 +540,12 @@ pub fn world(data: &[u8]) {
         };
     let mut scratch = vec![Projected::default(); scratch_len];
     let frame = r.transform_mesh(&mesh, &m, &vp, &mut scratch);
+    if std::env::var_os("WRASTER_FUZZ_DEBUG").is_some() {
+        eprintln!(
+            "{w}x{h} {st:?}\n{m:?}\n{vp:?}\n{positions:?}\n{indices:?}\n{:?}",
+            frame.as_ref().map(|f| f.vertices().to_vec())
+        );
+    }
     let mut mcanvas = Canvas::new(w as u32, h as u32);
     let mut mdepth = Guarded::new(n, 0u16, 0xa5a5);
     mdepth.inner().copy_from_slice(&cleared);
