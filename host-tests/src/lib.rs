@@ -490,3 +490,45 @@ pub fn render_torus<R: SpanRecip>(
     })?;
     Ok((frame, depth, stats))
 }
+
+/// A cube from -1 to 1, twelve triangles, every face wound counter-clockwise seen from outside: a closed convex mesh.
+pub fn cube() -> ([[f32; 3]; 8], [[u16; 3]; 12]) {
+    (
+        [
+            [-1.0, -1.0, -1.0],
+            [1.0, -1.0, -1.0],
+            [1.0, 1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+            [1.0, -1.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [-1.0, 1.0, 1.0],
+        ],
+        [
+            [0, 3, 2],
+            [0, 2, 1],
+            [4, 5, 6],
+            [4, 6, 7],
+            [0, 1, 5],
+            [0, 5, 4],
+            [2, 3, 7],
+            [2, 7, 6],
+            [1, 2, 6],
+            [1, 6, 5],
+            [0, 4, 7],
+            [0, 7, 3],
+        ],
+    )
+}
+
+/// Every depth comparison.
+pub const COMPARES: [wraster::Compare; 8] = [
+    wraster::Compare::Never,
+    wraster::Compare::Less,
+    wraster::Compare::Equal,
+    wraster::Compare::LessEqual,
+    wraster::Compare::Greater,
+    wraster::Compare::NotEqual,
+    wraster::Compare::GreaterEqual,
+    wraster::Compare::Always,
+];

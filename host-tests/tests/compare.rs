@@ -62,16 +62,7 @@ fn all_eight_comparisons_with_write_on_and_off() {
         [(2.0, 3.0, 40.0), (60.0, 6.0, 400.0), (8.0, 45.0, 120.0)],
         Rgb565::GREEN,
     );
-    let all = [
-        Compare::Never,
-        Compare::Less,
-        Compare::Equal,
-        Compare::LessEqual,
-        Compare::Greater,
-        Compare::NotEqual,
-        Compare::GreaterEqual,
-        Compare::Always,
-    ];
+    let all = host_tests::COMPARES;
     let (c0, d0, _) = draw(&[(first, Compare::Always)], true);
     let mut passes = [0usize; 8];
     for second in [crossing, same] {

@@ -467,16 +467,7 @@ fn every_comparison_on_the_packed_path() {
     let scene = Scene::Overdraw;
     let (n, f) = scene.depth_range();
     let tris: Vec<_> = scene.tris().collect();
-    for cmp in [
-        Compare::Never,
-        Compare::Less,
-        Compare::Equal,
-        Compare::LessEqual,
-        Compare::Greater,
-        Compare::NotEqual,
-        Compare::GreaterEqual,
-        Compare::Always,
-    ] {
+    for cmp in host_tests::COMPARES {
         for write in [true, false] {
             let state = RenderState {
                 compare: cmp,

@@ -225,40 +225,11 @@ fn bands_equal_the_whole_frame() {
     }
 }
 
-fn cube() -> ([[f32; 3]; 8], [[u16; 3]; 12]) {
-    (
-        [
-            [-1.0, -1.0, -1.0],
-            [1.0, -1.0, -1.0],
-            [1.0, 1.0, -1.0],
-            [-1.0, 1.0, -1.0],
-            [-1.0, -1.0, 1.0],
-            [1.0, -1.0, 1.0],
-            [1.0, 1.0, 1.0],
-            [-1.0, 1.0, 1.0],
-        ],
-        [
-            [0, 3, 2],
-            [0, 2, 1],
-            [4, 5, 6],
-            [4, 6, 7],
-            [0, 1, 5],
-            [0, 5, 4],
-            [2, 3, 7],
-            [2, 7, 6],
-            [1, 2, 6],
-            [1, 6, 5],
-            [0, 4, 7],
-            [0, 7, 3],
-        ],
-    )
-}
-
 /// Bad mesh input is refused before anything is written: an index beyond the vertices, too few face colours, a
 /// short scratch, a NaN position, a NaN in the matrix.
 #[test]
 fn bad_meshes_are_errors_and_write_nothing() {
-    let (pos, idx) = cube();
+    let (pos, idx) = host_tests::cube();
     let cam = Camera::look_at(
         [3.0, 2.0, 5.0],
         [0.0; 3],
@@ -354,7 +325,7 @@ fn bad_meshes_are_errors_and_write_nothing() {
 /// pixel exactly once.
 #[test]
 fn a_closed_cube_writes_each_pixel_once_and_draws_from_inside() {
-    let (pos, idx) = cube();
+    let (pos, idx) = host_tests::cube();
     let vp = Viewport::new(0.0, 0.0, 64.0, 48.0);
     for eye in [[3.0, 2.0, 5.0], [-4.0, -3.0, 2.5], [0.2, 0.1, 0.3]] {
         let cam = Camera::look_at(

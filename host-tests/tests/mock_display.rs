@@ -11,32 +11,6 @@ use wraster::mesh::{Colors, Mesh, Projected};
 use wraster::projection::{Camera, Mat4};
 use wraster::{Cull, DepthMode, DepthStore, Rasterizer, RenderState, Vertex};
 
-/// A unit cube, every face wound counter-clockwise seen from outside.
-const CUBE: [[f32; 3]; 8] = [
-    [-1.0, -1.0, -1.0],
-    [1.0, -1.0, -1.0],
-    [1.0, 1.0, -1.0],
-    [-1.0, 1.0, -1.0],
-    [-1.0, -1.0, 1.0],
-    [1.0, -1.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [-1.0, 1.0, 1.0],
-];
-const FACES: [[u16; 3]; 12] = [
-    [0, 3, 2],
-    [0, 2, 1], // z = -1
-    [4, 5, 6],
-    [4, 6, 7], // z = +1
-    [0, 1, 5],
-    [0, 5, 4], // y = -1
-    [3, 7, 6],
-    [3, 6, 2], // y = +1
-    [0, 4, 7],
-    [0, 7, 3], // x = -1
-    [1, 2, 6],
-    [1, 6, 5], // x = +1
-];
-
 #[test]
 fn closed_cube_with_depth_off_writes_no_pixel_twice() {
     let camera = Camera::look_at(
@@ -56,9 +30,10 @@ fn closed_cube_with_depth_off_writes_no_pixel_twice() {
     let faces: Vec<Rgb565> = (0..12)
         .map(|k| Rgb565::new(k as u8 * 2, 63 - k as u8 * 4, 31))
         .collect();
+    let (positions, indices) = host_tests::cube();
     let mesh = Mesh {
-        positions: &CUBE,
-        indices: &FACES,
+        positions: &positions,
+        indices: &indices,
         colors: Colors::PerFace(&faces),
     };
     let vp = Viewport::new(0.0, 0.0, 64.0, 64.0);
