@@ -3,18 +3,25 @@
 its filters), and this applies each one in a scratch git worktree and runs the tests that judge the core against the
 f64 reference (cargo-mutants itself runs only the mutated package's tests, and the judging tests live in host-tests).
 
-    python3 host-tests/mutants.py OUT.json [cargo-mutants filter args, e.g. --file src/edge.rs --re slope_bias]
+    python3 host-tests/mutants.py OUT.json [--jobs N] [cargo-mutants filter args, e.g. --file src/edge.rs]
 
-A mutant is caught when the build or a test fails, missed when every test passes, a timeout when the tests run
-past the limit (counted as caught: the mutant changed behaviour), unviable when it does not compile.
+Each mutant is judged first by the core's own unit tests (`cargo test -p wraster --lib`, about a second), then, if
+they pass, by `host-tests/mutants/judge.rs`: the suites that compare the core with the f64 reference (bad input,
+bias, boundaries, clip, fixed input, formats, fuzz regressions, Gouraud, MockDisplay, reference, stiff), built as one
+binary in the `mutants` profile (opt-level 1, overflow checks on, no debug info), so a mutant costs about 20 s.
+`--jobs N` judges N mutants at once, each in its own worktree (/tmp/wraster-mutants-<i>).
+
+A mutant is caught when a test fails, missed when every test passes, a timeout when the tests run past the limit
+(counted as caught: the mutant changed behaviour), unviable when it does not compile. OUT.json keeps the outcomes, so
+an interrupted run resumes; the last line is `mutants caught=.. missed=.. timeout=.. unviable=.. total=..`.
 """
-import json, os, subprocess, sys, time
+import json, os, subprocess, sys, threading, time
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-WT = "/tmp/wraster-mutants"
-TESTS = ["boundaries", "bias", "reference", "stiff", "mock_display", "bad_input", "fixed_input", "formats",
-         "gouraud", "clip", "fuzz_regressions"]
-TIMEOUT = 600
+TIMEOUT = 120
+UNIT = ["cargo", "test", "--profile", "mutants", "-p", "wraster", "--all-features", "--lib"]
+JUDGE = ["cargo", "test", "--profile", "mutants", "-p", "host-tests", "--test", "mutants_judge"]
+
 
 def run(cmd, cwd, timeout=None):
     try:
@@ -23,46 +30,74 @@ def run(cmd, cwd, timeout=None):
     except subprocess.TimeoutExpired:
         return "timeout"
 
+
+def built(cmd, cwd):
+    return run(cmd + ["--no-run"], cwd) == 0
+
+
+def judge(m, wt):
+    path = os.path.join(wt, m["file"])
+    orig = open(path).read()
+    lines = orig.split("\n")
+    s, e = m["span"]["start"], m["span"]["end"]
+    # span columns are 1-based, end exclusive; lines 1-based
+    start = sum(len(l) + 1 for l in lines[: s["line"] - 1]) + s["column"] - 1
+    end = sum(len(l) + 1 for l in lines[: e["line"] - 1]) + e["column"] - 1
+    open(path, "w").write(orig[:start] + m["replacement"] + orig[end:])
+    try:
+        if not built(UNIT, wt):
+            return "unviable"
+        r = run(UNIT, wt, TIMEOUT)
+        if r == 0:
+            if not built(JUDGE, wt):
+                return "unviable"
+            r = run(JUDGE, wt, TIMEOUT)
+        return "missed" if r == 0 else ("timeout" if r == "timeout" else "caught")
+    finally:
+        open(path, "w").write(orig)
+
+
 def main():
-    out, filters = sys.argv[1], sys.argv[2:]
-    listing = subprocess.run(["cargo", "mutants", "--no-config", "--list", "--json"] + filters, cwd=REPO,
+    args = sys.argv[1:]
+    out = args.pop(0)
+    jobs = 1
+    if args[:1] == ["--jobs"]:
+        jobs = int(args[1])
+        args = args[2:]
+    listing = subprocess.run(["cargo", "mutants", "--no-config", "--list", "--json"] + args, cwd=REPO,
                              capture_output=True, text=True, check=True).stdout
     mutants = json.loads(listing)
-    if not os.path.isdir(WT):
-        subprocess.run(["git", "worktree", "add", "--detach", WT, "HEAD"], cwd=REPO, check=True)
-    subprocess.run(["git", "checkout", "--detach", subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPO,
-                    capture_output=True, text=True).stdout.strip()], cwd=WT, check=True)
-    test_cmd = ["cargo", "test", "--release", "-p", "host-tests"] + sum([["--test", t] for t in TESTS], [])
-    lib_cmd = ["cargo", "test", "--release", "-p", "wraster", "--lib"]
-    assert run(test_cmd, WT) == 0 and run(lib_cmd, WT) == 0, "the unmutated tree must pass"
+    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPO, capture_output=True, text=True).stdout.strip()
     results = json.load(open(out)) if os.path.exists(out) else {}
-    for m in mutants:
-        name = m["name"]
-        if name in results:
-            continue
-        path = os.path.join(WT, m["file"])
-        orig = open(path).read()
-        lines = orig.split("\n")
-        s, e = m["span"]["start"], m["span"]["end"]
-        # span columns are 1-based, end exclusive; lines 1-based
-        start = sum(len(l) + 1 for l in lines[: s["line"] - 1]) + s["column"] - 1
-        end = sum(len(l) + 1 for l in lines[: e["line"] - 1]) + e["column"] - 1
-        open(path, "w").write(orig[:start] + m["replacement"] + orig[end:])
-        t0 = time.time()
-        try:
-            if run(["cargo", "build", "--release", "-p", "wraster", "--all-features"], WT) != 0:
-                outcome = "unviable"
-            else:
-                r = run(lib_cmd, WT, TIMEOUT)
-                if r == 0:
-                    r = run(test_cmd, WT, TIMEOUT)
-                outcome = "missed" if r == 0 else ("timeout" if r == "timeout" else "caught")
-        finally:
-            open(path, "w").write(orig)
-        results[name] = outcome
-        print(f"{outcome:8} {time.time() - t0:5.0f}s {name}", flush=True)
-        json.dump(results, open(out, "w"), indent=1)
+    todo = [m for m in mutants if m["name"] not in results]
+    lock = threading.Lock()
+
+    def worker(i):
+        wt = f"/tmp/wraster-mutants-{i}"
+        if not os.path.isdir(wt):
+            subprocess.run(["git", "worktree", "add", "--detach", wt, head], cwd=REPO, check=True,
+                           stdout=subprocess.DEVNULL)
+        subprocess.run(["git", "checkout", "-q", "--detach", head], cwd=wt, check=True)
+        assert run(UNIT, wt) == 0 and run(JUDGE, wt) == 0, "the unmutated tree must pass"
+        while True:
+            with lock:
+                if not todo:
+                    return
+                m = todo.pop(0)
+            t0 = time.time()
+            outcome = judge(m, wt)
+            with lock:
+                results[m["name"]] = outcome
+                print(f"{outcome:8} {time.time() - t0:5.0f}s {m['name']}", flush=True)
+                json.dump(results, open(out, "w"), indent=1)
+
+    threads = [threading.Thread(target=worker, args=(i,)) for i in range(jobs)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
     counts = {k: sum(1 for v in results.values() if v == k) for k in ["caught", "missed", "timeout", "unviable"]}
     print("mutants " + " ".join(f"{k}={v}" for k, v in counts.items()) + f" total={len(results)}")
+
 
 main()

@@ -1,0 +1,26 @@
+//! The mutation run's judge (`host-tests/mutants.py`): the suites that judge the core's arithmetic against the f64
+//! reference, compiled into one test binary so a mutant costs one crate's build instead of eleven.
+//! Not run by `cargo test` (the same tests run there as their own binaries).
+
+#[path = "../tests/bad_input.rs"]
+mod bad_input;
+#[path = "../tests/bias.rs"]
+mod bias;
+#[path = "../tests/boundaries.rs"]
+mod boundaries;
+#[path = "../tests/clip.rs"]
+mod clip;
+#[path = "../tests/fixed_input.rs"]
+mod fixed_input;
+#[path = "../tests/formats.rs"]
+mod formats;
+#[path = "../tests/fuzz_regressions.rs"]
+mod fuzz_regressions;
+#[path = "../tests/gouraud.rs"]
+mod gouraud;
+#[path = "../tests/mock_display.rs"]
+mod mock_display;
+#[path = "../tests/reference.rs"]
+mod reference;
+#[path = "../tests/stiff.rs"]
+mod stiff;
