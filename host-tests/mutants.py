@@ -3,13 +3,14 @@
 its filters), and this applies each one in a scratch git worktree and runs the tests that judge the core against the
 f64 reference (cargo-mutants itself runs only the mutated package's tests, and the judging tests live in host-tests).
 
-    python3 host-tests/mutants.py OUT.json [--jobs N] [cargo-mutants filter args, e.g. --file src/edge.rs]
+    python3 host-tests/mutants.py OUT.json [--jobs N] [--missed-in PREV.json] [cargo-mutants filters, e.g. --file src/edge.rs]
 
 Each mutant is judged first by the core's own unit tests (`cargo test -p wraster --lib`, about a second), then, if
 they pass, by `host-tests/mutants/judge.rs`: the suites that compare the core with the f64 reference (bad input,
 bias, boundaries, clip, fixed input, formats, fuzz regressions, Gouraud, MockDisplay, reference, stiff), built as one
 binary in the `mutants` profile (opt-level 1, overflow checks on, no debug info), so a mutant costs about 20 s.
-`--jobs N` judges N mutants at once, each in its own worktree (/tmp/wraster-mutants-<i>).
+`--jobs N` judges N mutants at once, each in its own worktree (/tmp/wraster-mutants-<i>); `--missed-in PREV.json`
+judges again only the mutants PREV.json lists as missed (after new tests). The worktrees check out the last commit.
 
 A mutant is caught when a test fails, missed when every test passes, a timeout when the tests run past the limit
 (counted as caught: the mutant changed behaviour), unviable when it does not compile. OUT.json keeps the outcomes, so
@@ -60,13 +61,16 @@ def judge(m, wt):
 def main():
     args = sys.argv[1:]
     out = args.pop(0)
-    jobs = 1
-    if args[:1] == ["--jobs"]:
-        jobs = int(args[1])
+    jobs, only = 1, None
+    while args[:1] in (["--jobs"], ["--missed-in"]):
+        if args[0] == "--jobs":
+            jobs = int(args[1])
+        else:
+            only = {k for k, v in json.load(open(args[1])).items() if v == "missed"}
         args = args[2:]
     listing = subprocess.run(["cargo", "mutants", "--no-config", "--list", "--json"] + args, cwd=REPO,
                              capture_output=True, text=True, check=True).stdout
-    mutants = json.loads(listing)
+    mutants = [m for m in json.loads(listing) if only is None or m["name"] in only]
     head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPO, capture_output=True, text=True).stdout.strip()
     results = json.load(open(out)) if os.path.exists(out) else {}
     todo = [m for m in mutants if m["name"] not in results]

@@ -18,6 +18,8 @@ mod formats;
 mod fuzz_regressions;
 #[path = "../tests/gouraud.rs"]
 mod gouraud;
+#[path = "../tests/long_edges.rs"]
+mod long_edges;
 #[path = "../tests/mock_display.rs"]
 mod mock_display;
 #[path = "../tests/reference.rs"]
