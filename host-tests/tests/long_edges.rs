@@ -39,16 +39,27 @@ fn check<R: SpanRecip>() {
     let mut state = RenderState::new(10.0, 1000.0).unwrap();
     state.compare = Compare::Always;
     for (k, tri) in tris().iter().enumerate() {
-        let reference = reference_tri(&tri.map(|q| (q.x, q.y, q.rhw)), 10.0, 1000.0, W as i32, 0..H as i32)
-            .expect("non-degenerate");
+        let reference = reference_tri(
+            &tri.map(|q| (q.x, q.y, q.rhw)),
+            10.0,
+            1000.0,
+            W as i32,
+            0..H as i32,
+        )
+        .expect("non-degenerate");
         let mut want = vec![0u32; W as usize * H as usize];
         for p in &reference {
             want[p.y as usize * W as usize + p.x as usize] = 1;
         }
         // Rows 1..1089, all 16 columns but near the apex: enough rows for either failure to show.
-        assert!(reference.len() > 16 * 1000, "triangle {k}: {} pixels", reference.len());
+        assert!(
+            reference.len() > 16 * 1000,
+            "triangle {k}: {} pixels",
+            reference.len()
+        );
         for band_h in [H, 100] {
-            let (frame, _, _) = render::<R>(core::slice::from_ref(tri), state, W, H, band_h).unwrap();
+            let (frame, _, _) =
+                render::<R>(core::slice::from_ref(tri), state, W, H, band_h).unwrap();
             assert_eq!(frame.writes, want, "triangle {k}, bands of {band_h} rows");
         }
     }

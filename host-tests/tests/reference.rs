@@ -441,3 +441,36 @@ fn horizontal_edges_on_pixel_centres_match_reference() {
     }
     assert!(checked > 50_000, "{checked}");
 }
+
+/// `row_range` (the rows a triangle can cover, for binning into bands) against the rows whose centres `j + 0.5` lie in
+/// the snapped vertices' y-range, computed here in f64 (exact: snapped values are multiples of 1/256), and every row
+/// the reference covers lies inside it.
+#[test]
+fn row_range_is_the_rows_of_the_snapped_y_range() {
+    let mut rng = Rng(0x0e0e_5eed);
+    let mut covered = 0usize;
+    for _ in 0..5_000 {
+        let tri = random_tri(&mut rng, 10.0, 1000.0);
+        let (first, last) = wraster::row_range(&tri).unwrap();
+        let ys = tri.map(|v| host_tests::snap(v.y) as f64 / 256.0);
+        let (lo, hi) = (
+            ys.iter().cloned().fold(f64::MAX, f64::min),
+            ys.iter().cloned().fold(f64::MIN, f64::max),
+        );
+        assert_eq!(
+            (first, last),
+            ((lo - 0.5).ceil() as i32, (hi - 0.5).floor() as i32),
+            "{tri:?}"
+        );
+        let v = tri.map(|q| (q.x, q.y, q.rhw));
+        for p in reference_tri(&v, 10.0, 1000.0, W as i32, -1000..1000).unwrap_or_default() {
+            assert!(
+                (first..=last).contains(&p.y),
+                "row {} outside {first}..={last}: {tri:?}",
+                p.y
+            );
+            covered += 1;
+        }
+    }
+    assert!(covered > 100_000, "{covered} covered pixels checked");
+}
