@@ -9,7 +9,7 @@ Each mutant is judged first by the core's own unit tests (`cargo test -p wraster
 they pass, by `host-tests/mutants/judge.rs`: the suites that compare the core with the f64 reference (bad input,
 bias, boundaries, clip, fixed input, formats, fuzz regressions, Gouraud, MockDisplay, reference, stiff), built as one
 binary in the `mutants` profile (opt-level 1, overflow checks on, no debug info), so a mutant costs about 20 s.
-`--jobs N` judges N mutants at once, each in its own worktree (/tmp/wraster-mutants-<i>); `--missed-in PREV.json`
+`--jobs N` judges N mutants at once, each in its own worktree (/tmp/wraster-mutants-<i>, i from $MUTANTS_WORKTREE_BASE, default 0); `--missed-in PREV.json`
 judges again only the mutants PREV.json lists as missed (after new tests). The worktrees check out the last commit.
 
 A mutant is caught when a test fails, missed when every test passes, a timeout when the tests run past the limit
@@ -77,7 +77,7 @@ def main():
     lock = threading.Lock()
 
     def worker(i):
-        wt = f"/tmp/wraster-mutants-{i}"
+        wt = f"/tmp/wraster-mutants-{i + int(os.environ.get('MUTANTS_WORKTREE_BASE', '0'))}"
         if not os.path.isdir(wt):
             subprocess.run(["git", "worktree", "add", "--detach", wt, head], cwd=REPO, check=True,
                            stdout=subprocess.DEVNULL)
