@@ -73,7 +73,12 @@ def main():
     mutants = [m for m in json.loads(listing) if only is None or m["name"] in only]
     head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPO, capture_output=True, text=True).stdout.strip()
     results = json.load(open(out)) if os.path.exists(out) else {}
-    todo = [m for m in mutants if m["name"] not in results]
+    # Mutants another run (MUTANTS_ALSO: its OUT.json files, comma-separated) has judged are skipped.
+    done = set(results)
+    for other in filter(None, os.environ.get("MUTANTS_ALSO", "").split(",")):
+        if os.path.exists(other):
+            done |= set(json.load(open(other)))
+    todo = [m for m in mutants if m["name"] not in done]
     lock = threading.Lock()
 
     def worker(i):
