@@ -86,7 +86,7 @@ def main():
         if not os.path.isdir(wt):
             subprocess.run(["git", "worktree", "add", "--detach", wt, head], cwd=REPO, check=True,
                            stdout=subprocess.DEVNULL)
-        subprocess.run(["git", "checkout", "-q", "--detach", head], cwd=wt, check=True)
+        subprocess.run(["git", "checkout", "-q", "-f", "--detach", head], cwd=wt, check=True)
         assert run(UNIT, wt) == 0 and run(JUDGE, wt) == 0, "the unmutated tree must pass"
         while True:
             with lock:
