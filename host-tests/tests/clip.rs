@@ -161,6 +161,31 @@ fn a_ground_plane_from_behind_the_eye_to_beyond_the_far_plane() {
     }
 }
 
+/// One vertex far beyond each guard-band plane in turn (and beyond two at a corner), in front of the near plane, so
+/// only that plane clips it. At eye depth 2 a point maps to `(48 + 18 x, 36 - 18 y)` px: `(-3000, 150)` to
+/// `(-53952, -2664)`, 13 times beyond the 4000 px band on one axis and inside it on the other, so a missing plane would
+/// leave the vertex to the rasterizer's clamp and turn the edges towards it (slope 0.66 instead of 0.05 here).
+/// Each clipped wedge must cover the frame as the ray caster's triangle does.
+#[test]
+fn triangles_beyond_each_guard_band_plane_are_clipped_there() {
+    let far = [
+        (-3000.0f32, 150.0f32),
+        (3000.0, -150.0),
+        (150.0, 3000.0),
+        (-150.0, -3000.0),
+        (-3000.0, 3000.0),
+        (3000.0, -3000.0),
+    ];
+    for (k, (x, y)) in far.into_iter().enumerate() {
+        let t = [[x, y, 2.0], [1.0, -1.0, 2.5], [-0.5, 1.5, 3.0]];
+        let (drawn, compared) = check(t);
+        assert!(
+            drawn > 100 && compared > W as usize * H as usize / 2,
+            "case {k}: {drawn} drawn, {compared} compared"
+        );
+    }
+}
+
 #[test]
 fn bad_world_input_is_an_error_and_writes_nothing() {
     let m = projection();
