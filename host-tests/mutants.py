@@ -19,7 +19,7 @@ an interrupted run resumes; the last line is `mutants caught=.. missed=.. timeou
 import json, os, subprocess, sys, threading, time
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-TIMEOUT = 120
+TIMEOUT = 60
 UNIT = ["cargo", "test", "--profile", "mutants", "-p", "wraster", "--all-features", "--lib"]
 JUDGE = ["cargo", "test", "--profile", "mutants", "-p", "host-tests", "--test", "mutants_judge"]
 
