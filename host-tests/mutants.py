@@ -8,7 +8,7 @@ f64 reference (cargo-mutants itself runs only the mutated package's tests, and t
 Each mutant is judged first by the core's own unit tests (`cargo test -p wraster --lib`, about a second), then, if
 they pass, by `host-tests/mutants/judge.rs`: the suites that compare the core with the f64 reference (bad input,
 bias, boundaries, clip, fixed input, formats, fuzz regressions, Gouraud, MockDisplay, reference, stiff), built as one
-binary in the `mutants` profile (opt-level 1, overflow checks on, no debug info), so a mutant costs about 20 s.
+binary (its own package, `host-tests/mutants/`, so host-tests' binaries are not rebuilt) in the `mutants` profile (opt-level 1, overflow checks on, no debug info), so a mutant costs about 20 s.
 `--jobs N` judges N mutants at once, each in its own worktree (/tmp/wraster-mutants-<i>, i from $MUTANTS_WORKTREE_BASE, default 0); `--missed-in PREV.json`
 judges again only the mutants PREV.json lists as missed (after new tests). The worktrees check out the last commit.
 
@@ -16,19 +16,23 @@ A mutant is caught when a test fails, missed when every test passes, a timeout w
 (counted as caught: the mutant changed behaviour), unviable when it does not compile. OUT.json keeps the outcomes, so
 an interrupted run resumes; the last line is `mutants caught=.. missed=.. timeout=.. unviable=.. total=..`.
 """
-import json, os, subprocess, sys, threading, time
+import json, os, signal, subprocess, sys, threading, time
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TIMEOUT = 60
 UNIT = ["cargo", "test", "--profile", "mutants", "-p", "wraster", "--all-features", "--lib"]
-JUDGE = ["cargo", "test", "--profile", "mutants", "-p", "host-tests", "--test", "mutants_judge"]
+JUDGE = ["cargo", "test", "--profile", "mutants", "-p", "wraster-mutants-judge", "--test", "judge"]
 
 
 def run(cmd, cwd, timeout=None):
+    # In a session of its own, so a timeout kills the test binary too, not only cargo (a mutant that loops would
+    # otherwise keep a core busy after its verdict).
+    p = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     try:
-        return subprocess.run(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                              timeout=timeout).returncode
+        return p.wait(timeout=timeout)
     except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        p.wait()
         return "timeout"
 
 

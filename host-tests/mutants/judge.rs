@@ -1,6 +1,7 @@
 //! The mutation run's judge (`host-tests/mutants.py`): the suites that judge the core's arithmetic against the f64
 //! reference, compiled into one test binary so a mutant costs one crate's build instead of eleven.
-//! Not run by `cargo test` (the same tests run there as their own binaries).
+//! A package of its own (so a mutant does not rebuild host-tests' binaries too), with `test = false`: `cargo test`
+//! does not run it, as the same tests run there as host-tests' own test binaries.
 
 #[path = "../tests/bad_input.rs"]
 mod bad_input;

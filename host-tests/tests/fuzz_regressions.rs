@@ -9,9 +9,12 @@ mod wraster_fuzz;
 use std::path::Path;
 
 fn replay(target: &str, check: fn(&[u8])) -> usize {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../fuzz/regressions")
-        .join(target);
+    // The repository's fuzz/ (this file is also built into host-tests/mutants/, one level deeper).
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .find(|d| d.join("fuzz/regressions").is_dir())
+        .expect("fuzz/regressions above the manifest");
+    let dir = root.join("fuzz/regressions").join(target);
     let mut n = 0;
     for e in std::fs::read_dir(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
         let path = e.unwrap().path();
