@@ -22,12 +22,17 @@ const ASPECT: f64 = W as f64 / H as f64;
 
 /// A W-friendly projection (fourth column [0, 0, 1, 0]: w = eye z).
 fn projection() -> Mat4 {
-    let q = FAR / (FAR - NEAR);
+    projection_near(NEAR)
+}
+
+/// [`projection`] with its near plane at `near`.
+fn projection_near(near: f64) -> Mat4 {
+    let q = FAR / (FAR - near);
     Mat4([
         [(S / ASPECT) as f32, 0.0, 0.0, 0.0],
         [0.0, S as f32, 0.0, 0.0],
         [0.0, 0.0, q as f32, 1.0],
-        [0.0, 0.0, (-q * NEAR) as f32, 0.0],
+        [0.0, 0.0, (-q * near) as f32, 0.0],
     ])
 }
 
@@ -45,8 +50,8 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// The eye depth where the ray through screen point (sx, sy) meets the triangle, if inside it and in [NEAR, FAR].
-fn cast(t: &[[f64; 3]; 3], sx: f64, sy: f64) -> Option<f64> {
+/// The eye depth where the ray through screen point (sx, sy) meets the triangle, if inside it and in [near, FAR].
+fn cast(t: &[[f64; 3]; 3], sx: f64, sy: f64, near: f64) -> Option<f64> {
     let xn = sx / (W as f64 / 2.0) - 1.0;
     let yn = 1.0 - sy / (H as f64 / 2.0);
     let dir = [xn * ASPECT / S, yn / S, 1.0];
@@ -56,7 +61,7 @@ fn cast(t: &[[f64; 3]; 3], sx: f64, sy: f64) -> Option<f64> {
         return None;
     }
     let z = dot(n, t[0]) / den;
-    if !(NEAR..=FAR).contains(&z) {
+    if !(near..=FAR).contains(&z) {
         return None;
     }
     let p = [dir[0] * z, dir[1] * z, dir[2] * z];
@@ -72,14 +77,19 @@ fn code(z: f64) -> f64 {
 
 /// Draws `t` and compares it with the ray caster; returns (pixels drawn, pixels compared).
 fn check(t: [[f32; 3]; 3]) -> (usize, usize) {
-    let m = projection();
+    check_near(t, NEAR)
+}
+
+/// [`check`] with the near plane at `near`.
+fn check_near(t: [[f32; 3]; 3], near: f64) -> (usize, usize) {
+    let m = projection_near(near);
     assert!(is_w_friendly(&m));
     let vp = Viewport::new(0.0, 0.0, W as f32, H as f32);
     let mut frame = Frame::new(W as u32, H as u32);
     let mut depth = vec![0u16; W as usize * H as usize];
     let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
     buf.clear();
-    let mut r: Rasterizer = Rasterizer::new(RenderState::new(NEAR as f32, FAR as f32).unwrap());
+    let mut r: Rasterizer = Rasterizer::new(RenderState::new(near as f32, FAR as f32).unwrap());
     r.draw_world(&mut frame, &mut buf, &m, &vp, &t, Rgb565::WHITE)
         .unwrap();
     let tf = t.map(|v| v.map(|c| c as f64));
@@ -95,7 +105,7 @@ fn check(t: [[f32; 3]; 3]) -> (usize, usize) {
                 (0.0, -0.75),
             ]
             .iter()
-            .map(|(dx, dy)| cast(&tf, cx + dx, cy + dy))
+            .map(|(dx, dy)| cast(&tf, cx + dx, cy + dy, near))
             .collect();
             let stored = depth[py * W as usize + px];
             drawn += usize::from(stored != W16_FAR || frame.writes[py * W as usize + px] > 0);
@@ -162,10 +172,11 @@ fn a_ground_plane_from_behind_the_eye_to_beyond_the_far_plane() {
 }
 
 /// One vertex far beyond each guard-band plane in turn (and beyond two at a corner), in front of the near plane, so
-/// only that plane clips it. At eye depth 2 a point maps to `(48 + 18 x, 36 - 18 y)` px: `(-3000, 150)` to
-/// `(-53952, -2664)`, 13 times beyond the 4000 px band on one axis and inside it on the other, so a missing plane would
-/// leave the vertex to the rasterizer's clamp and turn the edges towards it (slope 0.66 instead of 0.05 here).
-/// Each clipped wedge must cover the frame as the ray caster's triangle does.
+/// only that plane clips it. At eye depth `w` a point maps to `(48 + 36 x / w, 36 - 36 y / w)` px; at `w = 2`,
+/// `(-3000, 150)` maps to `(-53952, -2664)`, 13 times beyond the 4000 px band on one axis and inside it on the other,
+/// so a missing plane would leave the vertex to the rasterizer's clamp and turn the edges towards it (slope 0.66
+/// instead of 0.05 here). The same scene a tenth the size (near plane 0.1, `w = 0.2`) puts the planes' `k w` far
+/// from any `k + w`. Each clipped wedge must cover the frame as the ray caster's triangle does.
 #[test]
 fn triangles_beyond_each_guard_band_plane_are_clipped_there() {
     let far = [
@@ -176,13 +187,15 @@ fn triangles_beyond_each_guard_band_plane_are_clipped_there() {
         (-3000.0, 3000.0),
         (3000.0, -3000.0),
     ];
-    for (k, (x, y)) in far.into_iter().enumerate() {
-        let t = [[x, y, 2.0], [1.0, -1.0, 2.5], [-0.5, 1.5, 3.0]];
-        let (drawn, compared) = check(t);
-        assert!(
-            drawn > 100 && compared > W as usize * H as usize / 2,
-            "case {k}: {drawn} drawn, {compared} compared"
-        );
+    for scale in [1.0f32, 0.1] {
+        for (k, (x, y)) in far.into_iter().enumerate() {
+            let t = [[x, y, 2.0], [1.0, -1.0, 2.5], [-0.5, 1.5, 3.0]].map(|v| v.map(|c| c * scale));
+            let (drawn, compared) = check_near(t, NEAR * scale as f64);
+            assert!(
+                drawn > 100 && compared > W as usize * H as usize / 2,
+                "case {k} at scale {scale}: {drawn} drawn, {compared} compared"
+            );
+        }
     }
 }
 
