@@ -178,6 +178,30 @@ pub fn reference_tri(
     Some(out)
 }
 
+/// The reference's coverage of one triangle drawn alone with writes on and no depth rejection: 1 where a pixel is
+/// covered and in range in a `w x h` frame, else 0 (the shape of [`Frame::writes`]), and how many pixels that is.
+pub fn reference_writes(
+    v: &[Vertex<Rgb565>; 3],
+    near: f32,
+    far: f32,
+    w: u32,
+    h: u32,
+) -> (Vec<u32>, usize) {
+    let px = reference_tri(
+        &v.map(|q| (q.x, q.y, q.rhw)),
+        near,
+        far,
+        w as i32,
+        0..h as i32,
+    )
+    .unwrap_or_default();
+    let mut writes = vec![0u32; (w * h) as usize];
+    for p in px.iter().filter(|p| p.in_range) {
+        writes[(p.y as u32 * w + p.x as u32) as usize] = 1;
+    }
+    (writes, px.len())
+}
+
 /// The reference's final frame for a list of triangles with a `Less` test on exact W: colour, the exact `1/t` of the
 /// nearest surface, and its W16 code (65535 and 1.0 where nothing was drawn).
 pub struct RefFrame {
