@@ -6,8 +6,8 @@ f64 reference (cargo-mutants itself runs only the mutated package's tests, and t
     python3 host-tests/mutants.py OUT.json [--jobs N] [--missed-in PREV.json] [cargo-mutants filters, e.g. --file src/edge.rs]
 
 Each mutant is judged first by the core's own unit tests (`cargo test -p wraster --lib`, about a second), then, if
-they pass, by `host-tests/mutants/judge.rs`: the suites that compare the core with the f64 reference (bad input,
-bias, boundaries, clip, fixed input, formats, fuzz regressions, Gouraud, MockDisplay, reference, stiff), built as one
+they pass, by `host-tests/mutants/judge.rs`: the suites that compare the core with the f64 reference (every test file of host-tests/tests but the
+property tests, the commands and the firmware runs), built as one
 binary (its own package, `host-tests/mutants/`, so host-tests' binaries are not rebuilt) in the `mutants` profile (opt-level 1, overflow checks on, no debug info), so a mutant costs about 20 s.
 `--jobs N` judges N mutants at once, each in its own worktree (/tmp/wraster-mutants-<i>, i from $MUTANTS_WORKTREE_BASE, default 0); `--missed-in PREV.json`
 judges again only the mutants PREV.json lists as missed (after new tests). The worktrees check out the last commit.

@@ -1,5 +1,6 @@
 //! The mutation run's judge (`host-tests/mutants.py`): the suites that judge the core's arithmetic against the f64
-//! reference, compiled into one test binary so a mutant costs one crate's build instead of eleven.
+//! reference (every test file of host-tests/tests but the property tests, the commands and the firmware runs),
+//! compiled into one test binary, so a mutant costs one crate's build instead of sixteen.
 //! A package of its own (so a mutant does not rebuild host-tests' binaries too), with `test = false`: `cargo test`
 //! does not run it, as the same tests run there as host-tests' own test binaries.
 
@@ -11,6 +12,8 @@ mod bias;
 mod boundaries;
 #[path = "../tests/clip.rs"]
 mod clip;
+#[path = "../tests/compare.rs"]
+mod compare;
 #[path = "../tests/fixed_input.rs"]
 mod fixed_input;
 #[path = "../tests/formats.rs"]
@@ -19,11 +22,19 @@ mod formats;
 mod fuzz_regressions;
 #[path = "../tests/gouraud.rs"]
 mod gouraud;
+#[path = "../tests/grazing.rs"]
+mod grazing;
 #[path = "../tests/long_edges.rs"]
 mod long_edges;
+#[path = "../tests/mesh.rs"]
+mod mesh;
 #[path = "../tests/mock_display.rs"]
 mod mock_display;
+#[path = "../tests/primitives.rs"]
+mod primitives;
 #[path = "../tests/reference.rs"]
 mod reference;
+#[path = "../tests/seed_numbers.rs"]
+mod seed_numbers;
 #[path = "../tests/stiff.rs"]
 mod stiff;

@@ -121,6 +121,18 @@ fn buffer_of_the_wrong_size() {
         }
     );
     assert!(DepthBuffer::new(&mut data, 10, 10).is_ok());
+    // An empty buffer is refused whichever side is zero, even though its length (0) then matches.
+    let empty: &mut [u16] = &mut [];
+    for (w, h) in [(0, 5), (5, 0), (0, 0)] {
+        assert_eq!(
+            DepthBuffer::new(empty, w, h).unwrap_err(),
+            Error::BufferSize {
+                expected: 0,
+                actual: 0
+            },
+            "{w} x {h}"
+        );
+    }
 }
 
 #[test]
