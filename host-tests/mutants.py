@@ -6,11 +6,12 @@ f64 reference (cargo-mutants itself runs only the mutated package's tests, and t
     python3 host-tests/mutants.py OUT.json [--jobs N] [--missed-in PREV.json] [cargo-mutants filters, e.g. --file src/edge.rs]
 
 Each mutant is judged first by the core's own unit tests (`cargo test -p wraster --lib`, about a second), then, if
-they pass, by `host-tests/mutants/judge.rs`: the suites that compare the core with the f64 reference (every test file of host-tests/tests but the
-property tests, the commands and the firmware runs), built as one
-binary (its own package, `host-tests/mutants/`, so host-tests' binaries are not rebuilt) in the `mutants` profile (opt-level 1, overflow checks on, no debug info), so a mutant costs about 20 s.
-`--jobs N` judges N mutants at once, each in its own worktree (/tmp/wraster-mutants-<i>, i from $MUTANTS_WORKTREE_BASE, default 0); `--missed-in PREV.json`
-judges again only the mutants PREV.json lists as missed (after new tests). The worktrees check out the last commit.
+they pass, by `host-tests/mutants/judge.rs`: every test file of host-tests/tests but the property tests, the commands
+and the firmware runs, built as one binary (a package of its own, so host-tests' binaries are not rebuilt) in the
+`mutants` profile (opt-level 1, overflow checks on, no debug info): 15 to 40 s a mutant on a 2-core VM.
+`--jobs N` judges N mutants at once, each in its own worktree (/tmp/wraster-mutants-<i>, i counted from
+$MUTANTS_WORKTREE_BASE, default 0); `--missed-in PREV.json` judges again only the mutants PREV.json lists as missed
+(after new tests); MUTANTS_ALSO=A.json,B.json skips mutants other runs have judged. Worktrees check out HEAD.
 
 A mutant is caught when a test fails, missed when every test passes, a timeout when the tests run past the limit
 (counted as caught: the mutant changed behaviour), unviable when it does not compile. OUT.json keeps the outcomes, so
