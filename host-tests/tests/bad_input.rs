@@ -135,6 +135,23 @@ fn buffer_of_the_wrong_size() {
     }
 }
 
+/// `DepthBuffer::get` on a band (frame rows 7..10 of a 5-wide frame): every pixel of the band reads its own element,
+/// and every pixel around it, in frame coordinates, reads `None`.
+#[test]
+fn depth_buffer_get_reads_its_band_only() {
+    let mut data: Vec<u16> = (100..115).collect();
+    let buf = DepthBuffer::band(&mut data, 5, 7, 3).unwrap();
+    for y in -2..14 {
+        for x in -2..8 {
+            let want = ((0..5).contains(&x) && (7..10).contains(&y))
+                .then(|| 100 + ((y - 7) * 5 + x) as u16);
+            assert_eq!(buf.get(x, y), want, "({x}, {y})");
+        }
+    }
+    assert_eq!(buf.get(0, i32::MIN), None);
+    assert_eq!(buf.get(i32::MAX, 7), None);
+}
+
 #[test]
 fn errors_display() {
     let s = format!(
