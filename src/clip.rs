@@ -175,14 +175,15 @@ impl Planes {
     }
 
     /// [`Planes::map`], refused with [`Error::WorldTooLarge`] when the result is not a drawable vertex: a NaN `x` or
-    /// `y`, or `rhw` not finite and positive (`1 / w` overflows for a `W_near` below about `3e-39`). (A fuzz finding:
-    /// a clipped vertex's interpolated coordinates could overflow after the last plane, and reach the draw as a
-    /// non-finite vertex after earlier triangles of the mesh had been drawn.)
+    /// `y` (both are clamped, so NaN is their only bad value), `w` not finite, or `rhw` infinite (`1 / W_near`
+    /// overflows for a `W_near` below about `3e-39`). `rhw = 1 / max(w, W_near)` with `W_near > 0` is never negative,
+    /// and zero only for `w = +inf`, so these four tests are all it needs. (A fuzz finding: a clipped vertex's
+    /// interpolated coordinates could overflow after the last plane, and reach the draw as a non-finite vertex after
+    /// earlier triangles of the mesh had been drawn.)
     #[inline]
     pub(crate) fn map_checked(&self, c: &[f32]) -> Result<[f32; 4], Error> {
         let v = self.map(c);
-        if v[0].is_nan() || v[1].is_nan() || !(v[3].is_finite() && v[3] > 0.0) || !c[3].is_finite()
-        {
+        if v[0].is_nan() || v[1].is_nan() || !v[3].is_finite() || !c[3].is_finite() {
             return Err(Error::WorldTooLarge);
         }
         Ok(v)
@@ -346,5 +347,66 @@ impl<R: SpanRecip> Rasterizer<R> {
             stats += self.draw(target, depth, &v)?;
         }
         Ok(stats)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn planes(near: f32) -> Planes {
+        Planes::new(near, &Viewport::new(0.0, 0.0, 240.0, 240.0)).unwrap()
+    }
+
+    /// Each of `map_checked`'s four refusals on its own (the other three components drawable), and a drawable
+    /// vertex accepted with `map`'s values.
+    #[test]
+    fn map_checked_refuses_each_undrawable_component_alone() {
+        let p = planes(1.0);
+        let good = [1.0, 2.0, 0.5, 4.0];
+        assert_eq!(p.map_checked(&good), Ok(p.map(&good)));
+        let bad = |c: [f32; 4], p: &Planes| {
+            assert_eq!(p.map_checked(&c), Err(Error::WorldTooLarge), "{c:?}")
+        };
+        // x NaN only (y, w and rhw fine).
+        bad([f32::NAN, 2.0, 0.5, 4.0], &p);
+        // y NaN only.
+        bad([1.0, f32::NAN, 0.5, 4.0], &p);
+        // w NaN or -inf: map takes max(w, W_near) = W_near, so x, y and rhw are finite; only w tells.
+        bad([1.0, 2.0, 0.5, f32::NAN], &p);
+        bad([1.0, 2.0, 0.5, f32::NEG_INFINITY], &p);
+        // w = +inf: rhw = 0 and x, y = 0 * x: finite, so again only w tells.
+        bad([1.0, 2.0, 0.5, f32::INFINITY], &p);
+        // rhw infinite only: W_near = 1e-40 (a subnormal), 1 / 1e-40 overflows; w is finite and x = y = 0.
+        bad([0.0, 0.0, 0.5, 1e-40], &planes(1e-40));
+        // A huge but finite w is drawable (rhw is a tiny positive normal number).
+        let far = [0.0, 0.0, 0.5, 1e38];
+        assert!(p.map_checked(&far).is_ok());
+    }
+
+    /// A distance that overflows at one vertex only refuses the triangle, even where the rest of the clip could go
+    /// on: `a` has `w = 1e38`, inside every guard-band plane by an infinite distance (`k w` overflows); `c` is behind
+    /// the eye and outside the near plane and three guard-band planes, so the polygon is clipped against them.
+    #[test]
+    fn a_distance_overflowing_at_one_vertex_is_world_too_large() {
+        let p = planes(1.0);
+        let c = [
+            [0.0, 0.0, 0.0, 1e38],
+            [1.0, 0.0, 0.0, 2.0],
+            [-300.0, 0.0, 0.0, -1.0],
+        ];
+        let codes = c.map(|v| p.outcode(&v));
+        assert_eq!(codes, [0, 0, 0b11011]);
+        assert!((1..5).all(|k| p.dist(k, &c[0]) == f32::INFINITY));
+        assert_eq!(
+            p.clip(&c, codes[0] | codes[1] | codes[2]).err(),
+            Some(Error::WorldTooLarge)
+        );
+        // The same triangle with a finite far vertex clips to a drawable polygon.
+        let c = [[0.0, 0.0, 0.0, 1e3], c[1], c[2]];
+        let poly = p
+            .clip(&c, c.iter().fold(0, |o, v| o | p.outcode(v)))
+            .unwrap();
+        assert!(poly.len() >= 3 && poly.iter().all(|v| p.map_checked(v).is_ok()));
     }
 }

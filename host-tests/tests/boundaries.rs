@@ -142,3 +142,28 @@ fn packed_w_formats_range_is_inclusive_at_both_planes() {
     packed::<W24F>();
     packed::<W32F>();
 }
+
+/// A strategy of a user's own that overshoots `1/t` by `2^-13` (its stated bound): at `W_far` its code rounds to
+/// `65535 (1 + 2^-13) = 65543`, past the format. A strategy whose bound reaches half a code (`2^-17` relative) gets
+/// the encoder's clamp, so the pixel stores 65535, the far code (not a wrapped 7, nor a debug-build panic).
+#[derive(Default)]
+struct Overshoot;
+
+impl SpanRecip for Overshoot {
+    const NAME: &'static str = "overshoot";
+    const MAX_REL_ERROR: f64 = 1.0 / 8192.0 + 1e-9;
+    fn recip(&mut self, m: u32) -> u32 {
+        let x = (1u64 << 62) / m as u64; // 2^62 / m <= 2^31 for m >= 2^31
+        (x + (x >> 13)) as u32 // <= 2^31 + 2^18: fits
+    }
+}
+
+#[test]
+fn an_overshooting_strategy_is_clamped_at_the_far_code() {
+    let rhw = 1.0 / FAR;
+    for gouraud in [false, true] {
+        let (written, code) = w16::<Overshoot>(rhw, gouraud);
+        assert_eq!(written, reference(rhw).1, "gouraud {gouraud}");
+        assert_eq!(code, W16_FAR, "gouraud {gouraud}");
+    }
+}
