@@ -669,6 +669,54 @@ mod tests {
         assert_eq!(Fast::MAX_REL_ERROR, crate::fast::FAST_MAX_REL_ERROR.max(pp));
     }
 
+    /// `PrevPixel`'s bound is the fixed point of its documented recurrence `e' = (2^-11 + e)^2 + 2^-29 + 2^-31 +
+    /// 2^-42` from the per-pixel bound, iterated here until it stops changing.
+    #[test]
+    fn prev_pixel_bound_is_the_fixed_point_of_its_recurrence() {
+        let p = |e: i32| 2f64.powi(e);
+        let mut e = Newton::<Lerp64, 1>::MAX_REL_ERROR + p(-31) + p(-42);
+        loop {
+            let n = (p(-11) + e) * (p(-11) + e) + p(-29) + p(-31) + p(-42);
+            if n <= e {
+                break;
+            }
+            e = n;
+        }
+        assert_eq!(PrevPixel::MAX_REL_ERROR, e);
+    }
+
+    /// `exact_u` is `2^(62 + frac) / T` rounded to nearest (ties up): `floor(q + 1/2) = floor((floor(2q) + 1) / 2)`,
+    /// from twice the quotient in plain u128 arithmetic; at `T = 2^frac` (the far plane) it is `2^62` exactly.
+    #[test]
+    fn exact_u_rounds_to_nearest() {
+        let mut state: u64 = 0x1234_5678_9ABC_DEF1;
+        for frac in [0u32, 16, 32, 40] {
+            assert_eq!(exact_u(1 << frac, frac), 1 << 62);
+            for _ in 0..2000 {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let t = (1u64 << frac) + state % (1u64 << (frac + 20));
+                let twice = (1u128 << (63 + frac)) / t as u128;
+                assert_eq!(exact_u(t, frac) as u128, (twice + 1) / 2, "t {t}");
+            }
+        }
+    }
+
+    /// `ends_in` looks at the span's first and last pixels, not one past the last: a span ending exactly on `hi`
+    /// (or `lo`) is in range, one a pixel longer is not.
+    #[test]
+    fn ends_in_checks_the_last_pixel() {
+        let (lo, hi) = (1u64 << 32, 1u64 << 40);
+        // 11 pixels from hi - 10 dt up to hi, and down to lo.
+        let dt = 1000i64;
+        assert!(ends_in(hi - 10 * 1000, dt, 11, lo, hi));
+        assert!(!ends_in(hi - 10 * 1000, dt, 12, lo, hi));
+        assert!(ends_in(lo + 10 * 1000, -dt, 11, lo, hi));
+        assert!(!ends_in(lo + 10 * 1000, -dt, 12, lo, hi));
+        assert!(ends_in(lo, 0, 1, lo, hi) && !ends_in(lo - 1, 0, 1, lo, hi));
+    }
+
     /// The seed tables hold their definitions correctly rounded (a `const fn` cannot call `f64::round`, so the
     /// tables add a half and truncate): `Table64`'s entry `k` is `2^30 * 2 / (a + b) = 2^38 / (129 + 2k)`, rounded in
     /// integer arithmetic here; `Lerp64`'s two columns are the rounded `(1/a - s) 2^30` and `(1/a - 1/b) 2^30`.
