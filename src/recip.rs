@@ -714,6 +714,64 @@ mod tests {
         assert_eq!(Quake::<8>::span_bound(1 << 32, 1 << 30, 5), b(8.0));
     }
 
+    /// Quake's exact points: pixel 0, every `N`-th pixel and the span's last pixel carry `exact_u` itself; a span
+    /// partly out of range gets `None` exactly at its out-of-range pixels and `exact_u` at the others (and so does
+    /// a per-pixel reciprocal's walk, within its bound). Spans cross `lo` or `hi` in both directions.
+    #[test]
+    fn walks_give_exact_points_and_none_out_of_range() {
+        fn check<S: WSpan>(exact_points: Option<usize>, bound: impl Fn(u64, i64, usize) -> f64) {
+            let (frac, lo, hi) = (32u32, 1u64 << 32, 1u64 << 40);
+            let mut state: u64 = 0x0DDB_1A5E_5BAD_5EED;
+            let (mut nones, mut somes) = (0, 0);
+            for i in 0..3000 {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let n = 1 + (state % 200) as usize;
+                // Half the spans start in range near an end and run out; the others start anywhere near the ends.
+                let edge = if i % 2 == 0 { lo } else { hi };
+                let t0 = edge - (1 << 20) + (state >> 12) % (1 << 21);
+                let dt = ((state >> 40) % (1 << 14)) as i64 - (1 << 13);
+                let (mut s, b) = (S::default(), bound(t0, dt, n));
+                s.walk(t0, dt, n, frac, lo, hi, |k, u| -> Result<(), ()> {
+                    let t = t0.wrapping_add((dt as u64).wrapping_mul(k as u64));
+                    if !(lo..=hi).contains(&t) {
+                        assert_eq!(u, None, "{} t {t}", S::NAME);
+                        nones += 1;
+                        return Ok(());
+                    }
+                    let u = u.expect("in range");
+                    somes += 1;
+                    let exact = exact_u(t, frac);
+                    match exact_points {
+                        Some(nn) if k % nn == 0 || k == n - 1 => {
+                            assert_eq!(u, exact, "{} k {k}", S::NAME)
+                        }
+                        _ => {
+                            let e = (u as f64 / exact as f64 - 1.0).abs();
+                            assert!(e <= b, "{} k {k} e {e:e}", S::NAME);
+                        }
+                    }
+                    Ok(())
+                })
+                .unwrap();
+            }
+            assert!(nones > 1000 && somes > 1000, "{nones} {somes}");
+        }
+        check::<Quake<8>>(Some(8), Quake::<8>::span_bound);
+        check::<Quake<16>>(Some(16), Quake::<16>::span_bound);
+        check::<PerPixel<DefaultRecip>>(None, |_, _, _| PerPixel::<DefaultRecip>::MAX_REL_ERROR);
+        check::<PrevPixel>(None, |_, _, _| PrevPixel::MAX_REL_ERROR);
+    }
+
+    #[test]
+    fn quake_names() {
+        assert_eq!(
+            [Quake::<8>::NAME, Quake::<16>::NAME, Quake::<4>::NAME],
+            ["quake-8", "quake-16", "quake"]
+        );
+    }
+
     /// `ends_in` looks at the span's first and last pixels, not one past the last: a span ending exactly on `hi`
     /// (or `lo`) is in range, one a pixel longer is not.
     #[test]
