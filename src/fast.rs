@@ -444,6 +444,23 @@ mod tests {
         assert!(worst <= bound, "{worst:e}");
     }
 
+    /// The seed table is its documented definition, rounded to nearest (a `const fn` cannot call `f64::round`):
+    /// cell `k` is `[a, b)`, `a = 1/2 + k/256`, `b = a + 1/256`; the first column `1/a` lowered by half the gap
+    /// bound `(b - a)^2 / (4 a^2 b)` taken at `1/b`'s scale, the second the drop `1/a - 1/b`, both in units of `2^-29`.
+    /// (Recomputed here with `powi` and `round`; the sweep above cannot see a table entry off by a few units, as the
+    /// Newton step squares the seed's error away.)
+    #[test]
+    fn seed_table_is_its_definition_rounded() {
+        let q = 2f64.powi(29);
+        for (k, &(y, drop)) in seed_table().iter().enumerate() {
+            let a = 0.5 + k as f64 / 256.0;
+            let b = a + 2f64.powi(-8);
+            let gap = 2f64.powi(-16) / (4.0 * a * a * b * b);
+            assert_eq!(y, ((1.0 / a - gap / 2.0) * q).round() as u32, "cell {k}");
+            assert_eq!(drop, ((1.0 / a - 1.0 / b) * q).round() as u32, "cell {k}");
+        }
+    }
+
     /// Chained spans: `tau` walked as the loop walks it (64 bits, renormalised per binade), `x` carried by the
     /// extrapolated seed and one step wherever the binade allows chaining, fresh elsewhere; every pixel's `x` against
     /// the exact `2^X / tau` of the exact 64-bit value, within [`FAST_MAX_REL_ERROR`]. Returns (pixels, chained).
