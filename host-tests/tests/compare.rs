@@ -101,3 +101,101 @@ fn all_eight_comparisons_with_write_on_and_off() {
     assert_eq!(less + greater, not_equal);
     assert_eq!(less_equal + greater, always);
 }
+
+/// The fast tier's span loop (W16, `Less`, depth write: the default) over a stored depth that changes every pixel,
+/// so its passing runs open and close all along each span, on a steep and a shallow triangle: a pixel whose
+/// reference code `r` is at least 2 below the stored code is drawn once, with a code within 1 of `r` (the tier's
+/// bound: within 1 LSB of the correctly rounded code); one whose stored code is at most `r - 1` is not drawn and
+/// keeps it; the codes `r` and `r + 1`, which the 1-LSB bound leaves either way, are not judged. Uncovered pixels are
+/// untouched.
+#[test]
+fn fast_tier_runs_break_and_resume_where_the_stored_depth_says() {
+    let mut state: u64 = 0x5EED_0F_FA57;
+    let mut rnd = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    for p in [
+        [(2.0, 3.0, 12.0), (61.0, 9.0, 900.0), (20.0, 46.0, 300.0)],
+        [(1.0, 1.0, 400.0), (63.0, 20.0, 420.0), (5.0, 47.0, 410.0)],
+    ] {
+        let t = tri(p, Rgb565::RED);
+        let (near, far) = (10.0, 1000.0);
+        let reference = host_tests::reference_tri(
+            &t.map(|q| (q.x, q.y, q.rhw)),
+            near,
+            far,
+            W as i32,
+            0..H as i32,
+        )
+        .unwrap();
+        let mut stored: Vec<u16> = (0..W as usize * H as usize).map(|_| rnd() as u16).collect();
+        for r in &reference {
+            let off = (rnd() % 9) as i32 - 4;
+            stored[(r.y * W as i32 + r.x) as usize] = (r.code as i32 + off).clamp(0, 65535) as u16;
+        }
+        let mut depth = stored.clone();
+        let mut frame = Frame::new(W as u32, H as u32);
+        let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
+        Rasterizer::<wraster::recip::Fast>::new(RenderState::new(near, far).unwrap())
+            .draw(&mut frame, &mut buf, &t)
+            .unwrap();
+        let mut covered = vec![false; stored.len()];
+        let (mut drawn, mut kept) = (0, 0);
+        for r in reference.iter().filter(|r| r.in_range) {
+            let i = (r.y * W as i32 + r.x) as usize;
+            covered[i] = true;
+            let (s, rc) = (stored[i] as i32, r.code as i32);
+            if s >= rc + 2 {
+                assert_eq!(frame.writes[i], 1, "pixel {} {}", r.x, r.y);
+                assert!(
+                    (depth[i] as i32 - rc).abs() <= 1,
+                    "pixel {} {}: {} vs {rc}",
+                    r.x,
+                    r.y,
+                    depth[i]
+                );
+                drawn += 1;
+            } else if s <= rc - 1 {
+                assert_eq!(
+                    (frame.writes[i], depth[i]),
+                    (0, stored[i]),
+                    "pixel {} {}",
+                    r.x,
+                    r.y
+                );
+                kept += 1;
+            }
+        }
+        for i in (0..stored.len()).filter(|&i| !covered[i]) {
+            assert_eq!((frame.writes[i], depth[i]), (0, stored[i]));
+        }
+        assert!(drawn > 200 && kept > 200, "{drawn} {kept}");
+    }
+}
+
+/// `Less` is strict in the fast tier's loop too: the same triangle drawn a second time over its own depth writes
+/// nothing. The second draw takes the fresh reciprocal at pixels the first reached by chaining; the tier's contract
+/// alone lets the two differ by one code, and on these two triangles they agree at every pixel (so any pixel the
+/// second draw writes is an equal code passing `Less`).
+#[test]
+fn fast_tier_less_is_strict_on_a_second_identical_draw() {
+    for p in [
+        [(2.0, 3.0, 12.0), (61.0, 9.0, 900.0), (20.0, 46.0, 300.0)],
+        [(1.0, 1.0, 400.0), (63.0, 20.0, 420.0), (5.0, 47.0, 410.0)],
+    ] {
+        let t = tri(p, Rgb565::RED);
+        let mut depth = vec![0u16; W as usize * H as usize];
+        let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
+        buf.clear();
+        let mut r =
+            Rasterizer::<wraster::recip::Fast>::new(RenderState::new(10.0, 1000.0).unwrap());
+        let mut frame = Frame::new(W as u32, H as u32);
+        let first = r.draw(&mut frame, &mut buf, &t).unwrap();
+        let second = r.draw(&mut frame, &mut buf, &t).unwrap();
+        assert!(first.written > 500);
+        assert_eq!((second.fragments, second.written), (first.fragments, 0));
+    }
+}
