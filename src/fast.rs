@@ -222,8 +222,7 @@ pub(crate) fn span<D: DrawTarget>(
     let l0 = t0.leading_zeros() as i32 - 1;
     let tn = t0 << l0;
     let dn = dt << l0;
-    let v = tn + (tn >> 16) + (tn >> 32) + (tn >> 48);
-    let dv = dn + (dn >> 16) + (dn >> 32) + (dn >> 48);
+    let (v, dv) = (by_65535(tn), by_65535_signed(dn));
     if dt >= 0 {
         // tau in [2^30, 2^31): bit 62 on top.
         let (v, dv, lz) = if v >> 63 != 0 {
@@ -337,6 +336,20 @@ fn walk<const UP: bool, D: DrawTarget>(
     Ok(())
 }
 
+/// `x 65536 / 65535` as `x (1 + 2^-16 + 2^-32 + 2^-48)`: the series cut after four terms (below `2^-64` of `x`
+/// left out) and each shifted term floored, so at most 4 units below the exact value.
+#[inline(always)]
+fn by_65535(x: u64) -> u64 {
+    x + (x >> 16) + (x >> 32) + (x >> 48)
+}
+
+/// [`by_65535`] for a signed step: arithmetic shifts floor too (at most 4 units below), and for a negative step the
+/// left-out tail is negative, below one unit, so the result may also be up to one unit above the exact value.
+#[inline(always)]
+fn by_65535_signed(x: i64) -> i64 {
+    x + (x >> 16) + (x >> 32) + (x >> 48)
+}
+
 /// The passing run from `row[0]` (pixel `*k` of the span): until a pixel fails (`(true, _)`, `*k` at it, `v` not
 /// stepped past it), `tau` leaves the binade (`(_, true)`, `*k` and `v` past the last pixel drawn), or the row ends.
 #[inline(always)]
@@ -442,6 +455,24 @@ mod tests {
         }
         std::println!("fresh: worst {:.2} bits, bound 27.6", -worst.log2());
         assert!(worst <= bound, "{worst:e}");
+    }
+
+    /// `by_65535` is within 4 units below `x 65536 / 65535` (exact in u128/i128 here), for `x` in the range the
+    /// span gives it (`T` normalised to `[2^62, 2^63)`), and within `[-1, 4]` units for steps of both signs (a
+    /// negative step's left-out tail is below one unit above).
+    #[test]
+    fn by_65535_is_within_four_units() {
+        let mut s = 0xC0FF_EE00_1234_5678u64;
+        for _ in 0..100_000 {
+            let x = (1u64 << 62) | (rnd(&mut s) >> 2);
+            let exact = (x as u128 * 65536).div_euclid(65535);
+            let d = exact - by_65535(x) as u128;
+            assert!(d <= 4, "{x}: {d}");
+            let y = (rnd(&mut s) >> 2) as i64 * if rnd(&mut s) % 2 == 0 { 1 } else { -1 };
+            let exact = (y as i128 * 65536).div_euclid(65535);
+            let d = exact - by_65535_signed(y) as i128;
+            assert!((-1..=4).contains(&d), "{y}: {d}");
+        }
     }
 
     /// The seed table is its documented definition, rounded to nearest (a `const fn` cannot call `f64::round`):
