@@ -884,3 +884,49 @@ fn biased<F: Codec>(code: u32, bias: i32) -> u32 {
     };
     (code as i64 + b).clamp(0, F::MAX_CODE as i64) as u32
 }
+
+#[cfg(test)]
+mod float_bits_tests {
+    use super::float_bits;
+
+    /// `float_bits(p, e2, 23)` is the f32 nearest to `p 2^e2` (f64 holds `p < 2^53` exactly, and its conversion to
+    /// f32 rounds to nearest), with ties going up where f32 goes to even: every bit length of `p` from 1 to 53 (so
+    /// the short `p` shifted left as well as the long one rounded), random and all-ones mantissas (whose rounding
+    /// carries into the exponent), and exact ties.
+    #[test]
+    fn float_bits_is_f32_rounding_with_ties_up() {
+        let mut s = 0x0123_4567_89AB_CDEFu64;
+        let mut rnd = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        for bits in 1..=53u32 {
+            for k in 0..200 {
+                let top = 1u64 << (bits - 1);
+                let p = match k {
+                    0 => (top << 1) - 1, // all ones
+                    1 => top,
+                    _ => top | (rnd() & (top - 1)),
+                };
+                let e2 = (rnd() % 120) as i32 - 60 - bits as i32;
+                let v = p as f64 * 2f64.powi(e2);
+                let sh = bits.saturating_sub(24);
+                let tie = sh > 0 && p & ((1 << sh) - 1) == 1 << (sh - 1);
+                let want = if tie {
+                    // Ties up: the f32 above the halfway point.
+                    ((p + (1 << (sh - 1))) as f64 * 2f64.powi(e2)) as f32
+                } else {
+                    v as f32
+                };
+                assert_eq!(float_bits(p, e2, 23), want.to_bits(), "p {p:#x} e2 {e2}");
+            }
+        }
+        assert_eq!(float_bits(0, 5, 23), 0);
+        // A tie: 2^24 + 1 has one bit too many and it is a half: up to 2^24 + 2 (f32 itself would go to even, 2^24).
+        assert_eq!(float_bits((1 << 24) + 1, 0, 23), 16_777_218f32.to_bits());
+        // A carry: 2^25 - 1 rounds up to 2^25, the next exponent with a zero mantissa.
+        assert_eq!(float_bits((1 << 25) - 1, 0, 23), 33_554_432f32.to_bits());
+    }
+}
