@@ -468,7 +468,7 @@ mod tests {
             let exact = (x as u128 * 65536).div_euclid(65535);
             let d = exact - by_65535(x) as u128;
             assert!(d <= 4, "{x}: {d}");
-            let y = (rnd(&mut s) >> 2) as i64 * if rnd(&mut s) % 2 == 0 { 1 } else { -1 };
+            let y = (rnd(&mut s) >> 2) as i64 * if rnd(&mut s).is_multiple_of(2) { 1 } else { -1 };
             let exact = (y as i128 * 65536).div_euclid(65535);
             let d = exact - by_65535_signed(y) as i128;
             assert!((-1..=4).contains(&d), "{y}: {d}");

@@ -698,7 +698,7 @@ mod tests {
                 state ^= state << 17;
                 let t = (1u64 << frac) + state % (1u64 << (frac + 20));
                 let twice = (1u128 << (63 + frac)) / t as u128;
-                assert_eq!(exact_u(t, frac) as u128, (twice + 1) / 2, "t {t}");
+                assert_eq!(exact_u(t, frac) as u128, twice.div_ceil(2), "t {t}");
             }
         }
     }
@@ -794,7 +794,7 @@ mod tests {
         let t = table64();
         for (k, &v) in t.iter().enumerate() {
             let den = 129 + 2 * k as u64;
-            assert_eq!(v as u64, ((1u64 << 39) / den + 1) / 2, "table64[{k}]");
+            assert_eq!(v as u64, ((1u64 << 39) / den).div_ceil(2), "table64[{k}]");
         }
         let l = lerp64();
         let q = (1u64 << 30) as f64;
