@@ -560,6 +560,14 @@ impl<const N: usize> WSpan for Quake<N> {
 mod tests {
     use super::*;
 
+    /// xorshift64: reproducible test inputs.
+    fn xorshift(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
     /// Sweeps `m` over every 2^8-th value of `[2^31, 2^32)` and both ends of every seed cell and returns the largest
     /// relative error against `2^62 / m` (exact to 2^-53 in f64), two-sided.
     fn sweep<R: Recip32>() -> f64 {
@@ -693,9 +701,7 @@ mod tests {
         for frac in [0u32, 16, 32, 40] {
             assert_eq!(exact_u(1 << frac, frac), 1 << 62);
             for _ in 0..2000 {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
+                xorshift(&mut state);
                 let t = (1u64 << frac) + state % (1u64 << (frac + 20));
                 let twice = (1u128 << (63 + frac)) / t as u128;
                 assert_eq!(exact_u(t, frac) as u128, twice.div_ceil(2), "t {t}");
@@ -724,9 +730,7 @@ mod tests {
             let mut state: u64 = 0x0DDB_1A5E_5BAD_5EED;
             let (mut nones, mut somes) = (0, 0);
             for i in 0..3000 {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
+                xorshift(&mut state);
                 let n = 1 + (state % 200) as usize;
                 // Half the spans start in range near an end and run out; the others start anywhere near the ends.
                 let edge = if i % 2 == 0 { lo } else { hi };
@@ -825,12 +829,7 @@ mod tests {
     fn spans<R: SpanRecip>() -> (f64, u64, usize) {
         let (mut worst, mut pixels, mut smooth_spans) = (0.0f64, 0u64, 0);
         let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rnd = move || xorshift(&mut state);
         for _ in 0..6000 {
             let t0 = (1u64 << 30) + rnd() % (1u64 << (31 + rnd() % 31));
             let len = 1 + (rnd() % 400) as u32;
@@ -868,12 +867,7 @@ mod tests {
     fn walk_spans<S: WSpan>(bound: impl Fn(u64, i64, usize) -> f64) -> (f64, f64) {
         let (mut worst, mut worst_abs) = (0.0f64, 0.0f64);
         let mut state: u64 = 0x2545_F491_4F6C_DD1D;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rnd = move || xorshift(&mut state);
         let frac = 32;
         let (lo, hi) = (1u64 << frac, 1u64 << 62);
         for _ in 0..4000 {

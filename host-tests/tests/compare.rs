@@ -110,13 +110,8 @@ fn all_eight_comparisons_with_write_on_and_off() {
 /// untouched.
 #[test]
 fn fast_tier_runs_break_and_resume_where_the_stored_depth_says() {
-    let mut state: u64 = 0x05EE_D0FF_A57A;
-    let mut rnd = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        state
-    };
+    let mut rng = host_tests::Rng(0x05EE_D0FF_A57A);
+    let mut rnd = move || rng.bits();
     for p in [
         [(2.0, 3.0, 12.0), (61.0, 9.0, 900.0), (20.0, 46.0, 300.0)],
         [(1.0, 1.0, 400.0), (63.0, 20.0, 420.0), (5.0, 47.0, 410.0)],
