@@ -336,17 +336,72 @@ fn walk<const UP: bool, D: DrawTarget>(
     Ok(())
 }
 
+/// The W16 code of a pixel from `V = T 65536 / 65535` alone, with a fresh reciprocal (no previous pixel, no
+/// binade state): for the short spans of small triangles (`crate::small`), where a span's set-up would cost more
+/// than its pixels. `base = 77 - F`.
+///
+/// Conditions (the caller's): `2^50 <= V < 2^62`, and `base - lz <= 31` at the largest `V` drawn. Then `lz`, the
+/// leading zeros of `V`, lies in `[2, 13]` (the high word is never zero), `m = (V << lz) >> 32` is truncated by under
+/// `2^-31` relative, `x = fresh61(m)` is within `2^-27.6` of `2^61 / m`, and `x = 2^(93 - lz) / V`, so the code
+/// `2^(F+16) / V` is `x / 2^s` with `s = base - lz` (`>= 14`, as `V >= 2^F` in range), rounded to nearest as
+/// `((x >> (s - 1)) + 1) >> 1`. Relative error: `2^-27.6 + 2^-31 < 2^-27.2` ([`FAST_MAX_REL_ERROR`]) plus the
+/// caller's error in `V`; the code never exceeds 65535 (`65535 (1 + 2^-27.2) < 65535.5`).
+#[inline(always)]
+pub(crate) fn fresh_code(v: u64, base: u32) -> u16 {
+    let h = (v >> 32) as u32;
+    let lz = lz_small(h);
+    let m = (h << lz) | ((v as u32) >> (32 - lz));
+    let x = fresh61(m) as u32;
+    let s = base - lz;
+    (((x >> (s - 1)) + 1) >> 1) as u16
+}
+
+/// The leading zeros of `h` in `[2^18, 2^32)`: `CLZ` where the core has it; on the Cortex-M0 (no `CLZ`; there
+/// `leading_zeros` is a library call of about 27 instructions) [`lz_search`].
+#[inline(always)]
+fn lz_small(h: u32) -> u32 {
+    debug_assert!(h >= 1 << 18);
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    return lz_search(h);
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    return h.leading_zeros();
+}
+
+/// The leading zeros of `h >= 2^18` (so in `[0, 13]`) by four compares of a binary search (tested against
+/// `leading_zeros` on every host).
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn lz_search(h: u32) -> u32 {
+    let (mut h, mut n) = (h, 0);
+    if h < 1 << 24 {
+        n += 8;
+        h <<= 8;
+    }
+    if h < 1 << 28 {
+        n += 4;
+        h <<= 4;
+    }
+    if h < 1 << 30 {
+        n += 2;
+        h <<= 2;
+    }
+    n + u32::from(h < 1 << 31)
+}
+
 /// `x 65536 / 65535` as `x (1 + 2^-16 + 2^-32 + 2^-48)`: the series cut after four terms (below `2^-64` of `x`
 /// left out) and each shifted term floored, so at most 4 units below the exact value.
 #[inline(always)]
-fn by_65535(x: u64) -> u64 {
+pub(crate) fn by_65535(x: u64) -> u64 {
     x + (x >> 16) + (x >> 32) + (x >> 48)
 }
 
 /// [`by_65535`] for a signed step: arithmetic shifts floor too (at most 4 units below), and for a negative step the
 /// left-out tail is negative, below one unit, so the result may also be up to one unit above the exact value.
 #[inline(always)]
-fn by_65535_signed(x: i64) -> i64 {
+pub(crate) fn by_65535_signed(x: i64) -> i64 {
     x + (x >> 16) + (x >> 32) + (x >> 48)
 }
 
@@ -455,6 +510,22 @@ mod tests {
         }
         std::println!("fresh: worst {:.2} bits, bound 27.6", -worst.log2());
         assert!(worst <= bound, "{worst:e}");
+    }
+
+    /// The Cortex-M0's leading-zero search equals `leading_zeros` over its whole domain `[2^18, 2^32)` (every
+    /// 2^5-th value, and both ends of every binade).
+    #[test]
+    fn lz_search_is_leading_zeros() {
+        let mut h: u64 = 1 << 18;
+        while h < 1 << 32 {
+            assert_eq!(lz_search(h as u32), (h as u32).leading_zeros(), "{h}");
+            h += 1 << 5;
+        }
+        for b in 18..32 {
+            for h in [1u32 << b, ((1u64 << (b + 1)) - 1) as u32] {
+                assert_eq!(lz_search(h), h.leading_zeros(), "{h}");
+            }
+        }
     }
 
     /// `by_65535` is within 4 units below `x 65536 / 65535` (exact in u128/i128 here), for `x` in the range the

@@ -46,8 +46,9 @@ pub(crate) fn round_shift(m: u64, e: i32) -> u64 {
     }
 }
 
-/// `v * 2^frac_bits` rounded to nearest (ties to even), for `|v| <= limit`; `Err(())` outside, `Err` for non-finite too.
-#[inline]
+/// `v * 2^frac_bits` rounded to nearest (ties to even), for `|v| <= limit`; `Err(true)` outside, `Err(false)` for
+/// non-finite. The general 64-bit conversion, kept as the reference the 32-bit snap (`input::snap`) is tested against.
+#[cfg(test)]
 pub(crate) fn to_fixed(v: f32, frac_bits: i32, limit_log2: i32) -> Result<i64, bool> {
     let (neg, m, e) = split(v).ok_or(false)?;
     // |v| < 2^(e + 24): reject anything at or above 2^limit (m has at most 24 bits).

@@ -34,13 +34,38 @@ pub trait VertexInput: sealed::Sealed + Copy {
 }
 
 // Out of line: one copy instead of one per coordinate (flash), for a few instructions per vertex.
+/// `round(v * 256)`, ties to even, for `|v| < GUARD_BAND = 2^12` (else `OutOfGuardBand`; NaN and infinities
+/// `NonFinite`), in 32-bit integer operations on the bits: `|v| < 2^12` means a biased exponent of at most 138, so
+/// `v * 256 = m 2^-s` with the 24-bit mantissa `m` and `s = 142 - exp >= 4`: a right shift with round-to-nearest-even
+/// of a 32-bit value (no 64-bit shift, which is a library call on the Cortex-M0). The same value as
+/// `fixed::to_fixed(v, 8, 12)` (tested on every bit pattern class in the unit tests).
 #[inline(never)]
 fn snap(v: f32) -> Result<i32, Error> {
-    match crate::fixed::to_fixed(v, SUBPIXEL_BITS as i32, 12) {
-        Ok(s) => Ok(s as i32),
-        Err(false) => Err(Error::NonFinite),
-        Err(true) => Err(Error::OutOfGuardBand),
+    const _: () = assert!(GUARD_BAND == 1 << 12 && SUBPIXEL_BITS == 8);
+    let bits = v.to_bits();
+    let mag = bits & 0x7fff_ffff;
+    if mag >= 0x7f80_0000 {
+        return Err(Error::NonFinite);
     }
+    if mag >= 0x4580_0000 {
+        // 4096.0
+        return Err(Error::OutOfGuardBand);
+    }
+    let exp = mag >> 23;
+    if exp == 0 {
+        return Ok(0); // zero or subnormal: far below half a sub-pixel
+    }
+    let m = (mag & 0x7f_ffff) | 0x80_0000;
+    let s = 142 - exp; // >= 4
+    let r = if s >= 26 {
+        0 // m < 2^24 < 2^(s - 1): below half a unit
+    } else {
+        let q = m >> s;
+        let rem = m & ((1 << s) - 1);
+        let half = 1 << (s - 1);
+        q + u32::from(rem > half || (rem == half && q & 1 == 1))
+    } as i32;
+    Ok(if bits >> 31 != 0 { -r } else { r })
 }
 
 impl<C> sealed::Sealed for Vertex<C> {}
@@ -141,5 +166,55 @@ impl<C: Copy, R: Fixed<Bits = u32>> VertexInput for FixedVertex<C, R> {
     #[inline]
     fn color(&self) -> C {
         self.color
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 32-bit snap equals the general exact conversion (`to_fixed`, 64-bit) on every exponent, on ties (half a
+    /// sub-pixel, odd and even), at the guard band, on subnormals, zeros, NaN and infinities, and on random bits.
+    #[test]
+    fn snap_equals_the_exact_conversion() {
+        let reference = |v: f32| match crate::fixed::to_fixed(v, SUBPIXEL_BITS as i32, 12) {
+            Ok(s) => Ok(s as i32),
+            Err(false) => Err(Error::NonFinite),
+            Err(true) => Err(Error::OutOfGuardBand),
+        };
+        let check = |v: f32| assert_eq!(snap(v), reference(v), "{v:e} ({:#x})", v.to_bits());
+        for exp in 0..=255u32 {
+            for frac in [
+                0, 1, 2, 3, 0x40_0000, 0x40_0001, 0x3f_ffff, 0x7f_ffff, 0x7f_fffe,
+            ] {
+                for sign in [0, 1u32 << 31] {
+                    check(f32::from_bits(sign | exp << 23 | frac));
+                }
+            }
+        }
+        for k in -8192i32..=8192 {
+            // every half sub-pixel: the ties
+            check(k as f32 / 512.0);
+            check(k as f32 / 512.0 + 4000.0 * k.signum() as f32);
+        }
+        for v in [
+            4096.0,
+            -4096.0,
+            4095.999,
+            -4095.999,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ] {
+            check(v);
+        }
+        let mut s = 0x9E37_79B9u32;
+        for _ in 0..1_000_000 {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            check(f32::from_bits(s));
+            check(f32::from_bits(s & 0x45ff_ffff)); // mostly inside the guard band
+        }
     }
 }

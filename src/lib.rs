@@ -131,6 +131,7 @@ mod raster;
 pub mod recip;
 #[cfg(feature = "scenes")]
 pub mod scenes;
+mod small;
 mod state;
 
 pub use depth::{DepthBuffer, DepthStore, W16_FAR};

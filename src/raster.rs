@@ -254,6 +254,7 @@ impl<R: WSpan> Rasterizer<R> {
         };
         let exact = edges.iter().map(Edge::rows_exact).min().unwrap_or(1 << 24);
         Ok(Ok(Walk {
+            small,
             frac: s.frac,
             t_vertex: t_or,
             edges,
@@ -304,6 +305,15 @@ impl<R: SpanRecip> Rasterizer<R> {
             Err(stats) => return Ok(stats),
         };
         let color = v[0].color();
+        if R::FAST_W16
+            && w.small
+            && cmp == Compare::Less
+            && write
+            && w.span.bias() == 0
+            && crate::small::applies(&w)
+        {
+            return crate::small::draw(target, depth, &mut w, color);
+        }
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {
             if let Some((lo, hi)) = w.row(depth.width()) {
@@ -543,6 +553,8 @@ impl Plane {
 
 /// A prepared triangle being walked row by row.
 pub(crate) struct Walk {
+    /// Set up by the fast tier's small-triangle set-up (32-bit edges; see `prepare`).
+    pub(crate) small: bool,
     /// Fraction bits of `T`.
     pub(crate) frac: u32,
     /// The vertices' `T`, in oriented order.
