@@ -356,21 +356,30 @@ pub(crate) fn fresh_code(v: u64, base: u32) -> u16 {
     (((x >> (s - 1)) + 1) >> 1) as u16
 }
 
-/// The leading zeros of `h` in `[2^18, 2^32)`: `CLZ` where the core has it; on the Cortex-M0 (no `CLZ`; there
-/// `leading_zeros` is a library call of about 27 instructions) [`lz_search`].
+/// The leading zeros of `h` in `[2^18, 2^32)`: `CLZ` where the core has it; on the Cortex-M0 and RV32IMAC (no
+/// count-leading-zeros instruction; there `leading_zeros` is a library call of about 27 instructions) [`lz_search`].
 #[inline(always)]
 fn lz_small(h: u32) -> u32 {
     debug_assert!(h >= 1 << 18);
-    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    #[cfg(any(
+        all(target_arch = "arm", not(target_has_atomic = "32")),
+        target_arch = "riscv32"
+    ))]
     return lz_search(h);
-    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    #[cfg(not(any(
+        all(target_arch = "arm", not(target_has_atomic = "32")),
+        target_arch = "riscv32"
+    )))]
     return h.leading_zeros();
 }
 
 /// The leading zeros of `h >= 2^18` (so in `[0, 13]`) by four compares of a binary search (tested against
 /// `leading_zeros` on every host).
 #[cfg_attr(
-    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+    not(any(
+        all(target_arch = "arm", not(target_has_atomic = "32")),
+        target_arch = "riscv32"
+    )),
     allow(dead_code)
 )]
 #[inline(always)]
