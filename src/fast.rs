@@ -121,7 +121,7 @@ const fn seed_table() -> [(u32, u32); CELLS] {
 /// position truncated to 9 bits (`drop / 2^9 < 2^23 / 2^9` units, `2^-15` relative to `x > 2^29`), the entries' rounding:
 /// below `2^-14.8`; after the step `(2^-14.8)^2 + 2^-28 < 2^-27.6`.
 #[inline(always)]
-fn fresh61(m: u32) -> i32 {
+pub(crate) fn fresh61(m: u32) -> i32 {
     const T: [(u32, u32); CELLS] = seed_table();
     let (y, drop) = T[((m >> 24) & 127) as usize];
     let u = (m >> 15) & 511;
@@ -336,30 +336,10 @@ fn walk<const UP: bool, D: DrawTarget>(
     Ok(())
 }
 
-/// The W16 code of a pixel from `V = T 65536 / 65535` alone, with a fresh reciprocal (no previous pixel, no
-/// binade state): for the short spans of small triangles (`crate::small`), where a span's set-up would cost more
-/// than its pixels. `base = 77 - F`.
-///
-/// Conditions (the caller's): `2^50 <= V < 2^62`, and `base - lz <= 31` at the largest `V` drawn. Then `lz`, the
-/// leading zeros of `V`, lies in `[2, 13]` (the high word is never zero), `m = (V << lz) >> 32` is truncated by under
-/// `2^-31` relative, `x = fresh61(m)` is within `2^-27.6` of `2^61 / m`, and `x = 2^(93 - lz) / V`, so the code
-/// `2^(F+16) / V` is `x / 2^s` with `s = base - lz` (`>= 14`, as `V >= 2^F` in range), rounded to nearest as
-/// `((x >> (s - 1)) + 1) >> 1`. Relative error: `2^-27.6 + 2^-31 < 2^-27.2` ([`FAST_MAX_REL_ERROR`]) plus the
-/// caller's error in `V`; the code never exceeds 65535 (`65535 (1 + 2^-27.2) < 65535.5`).
-#[inline(always)]
-pub(crate) fn fresh_code(v: u64, base: u32) -> u16 {
-    let h = (v >> 32) as u32;
-    let lz = lz_small(h);
-    let m = (h << lz) | ((v as u32) >> (32 - lz));
-    let x = fresh61(m) as u32;
-    let s = base - lz;
-    (((x >> (s - 1)) + 1) >> 1) as u16
-}
-
 /// The leading zeros of `h` in `[2^18, 2^32)`: `CLZ` where the core has it; on the Cortex-M0 and RV32IMAC (no
 /// count-leading-zeros instruction; there `leading_zeros` is a library call of about 27 instructions) [`lz_search`].
 #[inline(always)]
-fn lz_small(h: u32) -> u32 {
+pub(crate) fn lz_small(h: u32) -> u32 {
     debug_assert!(h >= 1 << 18);
     #[cfg(any(
         all(target_arch = "arm", not(target_has_atomic = "32")),
@@ -403,14 +383,14 @@ fn lz_search(h: u32) -> u32 {
 /// `x 65536 / 65535` as `x (1 + 2^-16 + 2^-32 + 2^-48)`: the series cut after four terms (below `2^-64` of `x`
 /// left out) and each shifted term floored, so at most 4 units below the exact value.
 #[inline(always)]
-pub(crate) fn by_65535(x: u64) -> u64 {
+fn by_65535(x: u64) -> u64 {
     x + (x >> 16) + (x >> 32) + (x >> 48)
 }
 
 /// [`by_65535`] for a signed step: arithmetic shifts floor too (at most 4 units below), and for a negative step the
 /// left-out tail is negative, below one unit, so the result may also be up to one unit above the exact value.
 #[inline(always)]
-pub(crate) fn by_65535_signed(x: i64) -> i64 {
+fn by_65535_signed(x: i64) -> i64 {
     x + (x >> 16) + (x >> 32) + (x >> 48)
 }
 

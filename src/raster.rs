@@ -102,7 +102,7 @@ fn t_of(rhw: (u32, i32), far: (u32, i32)) -> Result<(u64, i32), Error> {
 }
 
 /// Rows whose pixel centre lies in the snapped vertices' y-range (possibly empty: first > last).
-fn rows_of(p: &[Sub; 3]) -> (i32, i32) {
+pub(crate) fn rows_of(p: &[Sub; 3]) -> (i32, i32) {
     let ymin = p[0].y.min(p[1].y).min(p[2].y);
     let ymax = p[0].y.max(p[1].y).max(p[2].y);
     let first = (ymin as i64 - 128 + 255).div_euclid(256) as i32; // ceil((ymin - 128) / 256)
@@ -189,7 +189,16 @@ impl<R: WSpan> Rasterizer<R> {
         rows: (i32, u16),
         fast: bool,
     ) -> Result<Result<Walk, Stats>, Error> {
-        let s = self.setup(v)?;
+        self.prepare_setup(self.setup(v)?, rows, fast)
+    }
+
+    /// [`Rasterizer::prepare`] from a snapped and checked triangle.
+    pub(crate) fn prepare_setup(
+        &self,
+        s: Setup,
+        rows: (i32, u16),
+        fast: bool,
+    ) -> Result<Result<Walk, Stats>, Error> {
         let [p0, p1, p2] = s.p;
         let area = (p1.x - p0.x) as i64 * (p2.y - p0.y) as i64
             - (p2.x - p0.x) as i64 * (p1.y - p0.y) as i64;
@@ -254,7 +263,6 @@ impl<R: WSpan> Rasterizer<R> {
         };
         let exact = edges.iter().map(Edge::rows_exact).min().unwrap_or(1 << 24);
         Ok(Ok(Walk {
-            small,
             frac: s.frac,
             t_vertex: t_or,
             edges,
@@ -300,20 +308,17 @@ impl<R: SpanRecip> Rasterizer<R> {
         D::Color: PixelColor,
     {
         let (cmp, write) = self.w16_test()?;
-        let mut w = match self.prepare(v, (depth.y0(), depth.height()), R::FAST_W16)? {
+        let s = self.setup(v)?;
+        if R::FAST_W16 && cmp == Compare::Less && write && !self.state.has_bias() {
+            if let Some(stats) = crate::small::draw(target, depth, &s, &self.state, v[0].color())? {
+                return Ok(stats);
+            }
+        }
+        let mut w = match self.prepare_setup(s, (depth.y0(), depth.height()), R::FAST_W16)? {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
         };
         let color = v[0].color();
-        if R::FAST_W16
-            && w.small
-            && cmp == Compare::Less
-            && write
-            && w.span.bias() == 0
-            && crate::small::applies(&w)
-        {
-            return crate::small::draw(target, depth, &mut w, color);
-        }
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {
             if let Some((lo, hi)) = w.row(depth.width()) {
@@ -553,8 +558,6 @@ impl Plane {
 
 /// A prepared triangle being walked row by row.
 pub(crate) struct Walk {
-    /// Set up by the fast tier's small-triangle set-up (32-bit edges; see `prepare`).
-    pub(crate) small: bool,
     /// Fraction bits of `T`.
     pub(crate) frac: u32,
     /// The vertices' `T`, in oriented order.

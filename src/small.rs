@@ -1,28 +1,43 @@
 //! The fast tier's small triangles: a triangle whose snapped box is under 8 px wide (so every span is shorter than the
-//! fast span loop's [`MIN_SPAN`]) and under 127 px high, drawn with `Less` and
-//! depth write, whose every vertex lies inside the depth range with a margin, walked by one out-of-line loop with
-//! few live values (inlined into the general draw, the same work spilled most of its registers: 51 instructions a
-//! pixel on the Cortex-M4 where this loop takes about 40).
+//! fast span loop's [`MIN_SPAN`]) and under 127 px high, drawn with `Less`, depth write and no bias, whose vertices
+//! lie inside the depth range with a margin and within a factor of 32 of each other in `T`. Set up and walked in one
+//! out-of-line function with its own coverage and depth arithmetic, and no plane solve: no division and no 128-bit
+//! product anywhere (the general set-up's are library calls on the 32-bit cores).
 //!
-//! **Rows.** The edges and the plane of `T` are the fast tier's small set-up ([`crate::raster`]'s `prepare`): 32-bit
-//! edge walks and the plane from one reciprocal of the area. Each row gives the covered columns `[lo, hi)`, exactly
-//! the general walk's.
+//! **Coverage.** The three edge functions `E_k(P) = A_k (P.x - x_k) + B_k (P.y - y_k)` (`crate::edge`'s, oriented
+//! so the inside is positive, less the top-left bias) are evaluated exactly in `i32` relative to the box's origin
+//! pixel: coordinates there are below `2^15` sub-pixels, `|A_k| < 2^15`, `|B_k| < 2^11`, so `|E_k| < 2^28` at every
+//! pixel centre of the box. A pixel is covered iff all three are `>= 0`: the top-left rule, exactly the general
+//! walk's pixels. Each row of the box is scanned from its left column with the edge functions alone: past the
+//! uncovered pixels, then to the end of the covered run (the triangle is convex); the depth loop then walks the run.
 //!
-//! **Range.** Every covered pixel's exact `T` is a convex combination of the vertices' (the plane through them), so
-//! lies in `[T_min, T_max]`; the computed plane errs by at most `(1 + k + l) / 2 <= 128` units (the exact solve) or
-//! `T_min 2^-34 + 2^16` units (`Plane::solve_fast`), both below [`margin`]. With `T_min - margin >= t_lo` and
-//! `T_max + margin <= t_hi` every computed `T` is in range, so the loop tests none.
+//! **Depth without a plane solve.** The edge function of the edge opposite vertex `k` is `2A` (the doubled area) at
+//! vertex `k` and 0 on that edge, so `S(P) = sum_k E_opp(k)(P) T'_k = 2A T'(P)`, with `T'(P)` the barycentric
+//! interpolation of the vertices' `T'_k = round(T_k / 2^25)`. `S` is linear with integer steps: walked in wrapping
+//! `u64` it is exact at every pixel, whatever the band (no rounding of steps at all). `T'_k <= 2^36` and
+//! `2A < 2^27`; the triangle is taken when `bits(2A) + bits(T'_max) <= 63`, and `S` is pre-shifted by
+//! `sh = 63 - bits(2A) - bits(T'_max)`, so every covered pixel's `S 2^sh` is below `2^63` (at least one leading zero). With `T'_min >= 2^31` (so `T_max / T_min < 32`), every covered `S` is at least `2^55`:
+//! its high word is never 0 and has at most 8 leading zeros.
 //!
-//! **Depth.** Per row `V = T 65536 / 65535` at the row's first pixel ([`by_65535`], at most 4 units below) and its
-//! step once per triangle ([`by_65535_signed`], at most 5 units off): after at most 126 steps `V` is within
-//! `4 + 126 * 5 < 2^10` units of exact, and the loop runs only when every `V` is at least `2^50` (checked on the
-//! vertices, less the margin), so below `2^-40` relative. Each pixel's code is [`fresh_code`]: a fresh reciprocal,
-//! `2^-27.2` with its truncations. Total `2^-27.2 + 2^-40`, inside [`FAST_MAX_REL_ERROR`]'s `6.5e-9`
-//! (`2^-27.2 = 6.46e-9`, `2^-40 < 1e-12`).
+//! **The code.** `code = 65535 2^F / T = K 2^(F - 25 + sh) / S` with `K = 65535 2A`, held as `kn 2^kz`
+//! (`kn` in `[2^31, 2^32)`, rounded). Per pixel: `lz` the leading zeros of `S`'s high word, `m = (S << lz) >> 32`, the
+//! fresh reciprocal `x = fresh61(m)` (`2^61 / m`, so `2^(93 - lz) / S`), `P = kn x` (64-bit), and
+//! `code = round(P / 2^(118 - kz - F - sh - lz))`; that shift is at least 44, so the rounding needs only `P`'s high
+//! word: `((hi >> (s - 1)) + 1) >> 1` with `s = 86 - kz - F - sh - lz` (floors of floors). The triangle is taken when
+//! `s <= 31` at every pixel.
 //!
-//! **Colour.** A row's pixels are tested in chunks of 32, each passing pixel a bit of a mask; the runs of set bits
-//! go to the target as `fill_solid` calls after the chunk (one call for a chunk that passes whole), so the depth
-//! loop calls nothing.
+//! **Error** (relative, of the computed code's value against the exact `65535 2^F / T` of the vertices' plane):
+//! `x` `2^-27.6` ([`fresh61`]); `m` truncated below `2^-31` (`m >= 2^31`); `kn` rounded, `2^-32`; `T'` rounded, half a
+//! unit of `T'_min >= 2^31`, `2^-32`. Sum: `4.95e-9 + 0.47e-9 + 0.23e-9 + 0.23e-9 = 5.88e-9`, inside the tier's
+//! [`FAST_MAX_REL_ERROR`] (`6.5e-9`), so the contract (every code within 1 LSB, at least 99.9% exact) holds as derived
+//! there. The code never exceeds 65535 (`65535 (1 + 5.9e-9) < 65535.5`).
+//!
+//! **Range.** Every covered pixel's exact `T` lies in `[T_min, T_max]` (a convex combination); the triangle is taken
+//! only when `T_min - margin >= t_lo` and `T_max + margin <= t_hi`, with a margin above the general set-up's plane
+//! error, so every pixel the general path would draw is in range there too, and no pixel needs a range test here.
+//!
+//! **Colour.** Each covered run is tested pixel by pixel, each passing pixel a bit of a mask; the run goes to the
+//! target as one `fill_solid` when every pixel passed, else as its passing runs, after the depth loop.
 
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::prelude::{Point, Size};
@@ -31,95 +46,193 @@ use embedded_graphics_core::primitives::Rectangle;
 use crate::depth::DepthBuffer;
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
-use crate::fast::{by_65535, by_65535_signed, fresh_code, MIN_SPAN};
-use crate::raster::{Plane, Stats, Walk, SUBPIXEL_BITS};
+use crate::fast::{fresh61, lz_small, MIN_SPAN};
+use crate::raster::{rows_of, Setup, Stats, SUBPIXEL_BITS};
+use crate::state::{Cull, RenderState};
 use crate::Error;
 
-/// The plane's largest error at a covered pixel, in units of `T`, for a triangle whose largest vertex `T` is
-/// `t_max`: above both set-ups' bounds (`128`, and `T_min 2^-34 + 2^16 <= t_max 2^-34 + 2^16`).
+/// The range margin, in units of `T`: above both general set-ups' plane error bounds (`128` units for the exact
+/// solve; `T_min 2^-34 + 2^16` for `Plane::solve_fast`), so the general path would find every pixel in range too.
 #[inline(always)]
 fn margin(t_max: u64) -> u64 {
     (t_max >> 32) + (1 << 17)
 }
 
-/// Whether [`draw`] applies to the prepared small triangle `w` (the caller has checked the comparison, the depth
-/// write and the bias): every pixel in range and `V` within [`fresh_code`]'s conditions.
+/// Bits of `v` (0 for 0).
 #[inline(always)]
-pub(crate) fn applies(w: &Walk) -> bool {
-    let t = w.t_vertex.map(|t| t as u64);
-    let (t_min, t_max) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
-    // Boxes under MIN_SPAN columns only: every span is short. Wider spans of small triangles keep the fast span
-    // loop, whose chained reciprocal costs less per pixel than a fresh one (measured on the terrain scene).
-    let x = w.geom.p.map(|p| p.x);
-    if x[0].max(x[1]).max(x[2]) - x[0].min(x[1]).min(x[2]) >= (MIN_SPAN as i32) << SUBPIXEL_BITS {
-        return false;
-    }
-    let e = margin(t_max);
-    let (lo, hi) = (t_min.wrapping_sub(e), t_max + e);
-    // t_min >= e keeps `lo` from wrapping; V(lo) >= lo >= 2^50; V(hi) < 2^62 as hi < 2^61 + 2^30.
-    t_min >= e
-        && lo >= 1 << 50
-        && lo >= w.span.t_lo
-        && hi <= w.span.t_hi
-        && 77 - w.frac as i32 - by_65535(hi).leading_zeros() as i32 <= 31
+fn bits(v: u64) -> u32 {
+    64 - v.leading_zeros()
 }
 
-/// Draws the prepared small triangle `w` (see [`applies`]) in `color`: `Less`, depth write, no bias.
+/// Draws the snapped triangle `s` in `color` if it is a small triangle this path takes (see the module doc), with
+/// `Less`, depth write and no bias (the caller's conditions). `Ok(None)`, having written nothing, where it does not
+/// apply: the general path then draws it.
 #[inline(never)]
 pub(crate) fn draw<D: DrawTarget>(
     target: &mut D,
     depth: &mut DepthBuffer<'_>,
-    w: &mut Walk,
+    s: &Setup,
+    state: &RenderState,
     color: D::Color,
-) -> Result<Stats, Error> {
-    let width = depth.width();
-    let dv = by_65535_signed(w.t.sx) as u64;
-    let base = 77 - w.frac;
-    let mut stats = Stats::default();
-    for j in w.geom.j0..=w.j1 {
-        if let Some((lo, hi)) = w.row(width) {
-            let mut v = by_65535(at_small(&w.t, (lo as i64 - w.geom.i_ref) as u32));
-            let row = &mut depth.row_mut(j)[lo as usize..hi as usize];
-            let mut x0 = lo;
-            for chunk in row.chunks_mut(32) {
-                // Bit `n - 1 - k` for pixel `k`: a shift and an OR a pixel.
-                let mut pass = 0u32;
-                for stored in chunk.iter_mut() {
-                    let c = fresh_code(v, base);
-                    let p = c < *stored;
-                    if p {
-                        *stored = c;
-                    }
-                    pass = (pass << 1) | u32::from(p);
-                    v = v.wrapping_add(dv);
-                }
-                let n = chunk.len() as u32;
-                stats.written += emit(target, x0, j, n, pass, color)?;
-                x0 += n as i32;
-            }
-            stats.fragments += (hi - lo) as u32;
-        }
-        w.next_row();
+) -> Result<Option<Stats>, Error> {
+    let p = s.p;
+    let (xmin, xmax) = (
+        p[0].x.min(p[1].x).min(p[2].x),
+        p[0].x.max(p[1].x).max(p[2].x),
+    );
+    let (ymin, ymax) = (
+        p[0].y.min(p[1].y).min(p[2].y),
+        p[0].y.max(p[1].y).max(p[2].y),
+    );
+    if xmax - xmin >= (MIN_SPAN as i32) << SUBPIXEL_BITS || ymax - ymin >= 126 << SUBPIXEL_BITS {
+        return Ok(None);
     }
-    Ok(stats)
+    // Relative to the box's origin pixel: below 2^15 sub-pixels, so the doubled area fits i32.
+    let (ox, oy) = (xmin >> SUBPIXEL_BITS, ymin >> SUBPIXEL_BITS);
+    let q = p.map(|v| (v.x - (ox << SUBPIXEL_BITS), v.y - (oy << SUBPIXEL_BITS)));
+    let area = (q[1].0 - q[0].0) * (q[2].1 - q[0].1) - (q[2].0 - q[0].0) * (q[1].1 - q[0].1);
+    let culled = Stats {
+        culled: 1,
+        ..Stats::default()
+    };
+    match state.cull {
+        _ if area == 0 => return Ok(Some(culled)),
+        Cull::Cw if area > 0 => return Ok(Some(culled)),
+        Cull::Ccw if area < 0 => return Ok(Some(culled)),
+        _ => {}
+    }
+    let (q, t) = if area < 0 {
+        ([q[0], q[2], q[1]], [s.t[0], s.t[2], s.t[1]])
+    } else {
+        (q, s.t)
+    };
+    let area2 = area.unsigned_abs() as u64;
+
+    // Depth range and the conditions of the module doc.
+    let t = t.map(|v| v as u64);
+    let (t_min, t_max) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+    let e = margin(t_max);
+    let t_hi = state.range.t_max(s.frac);
+    if t_min < e || t_min - e < 1u64 << s.frac || t_max + e > t_hi || t_min < 1 << 56 {
+        return Ok(None);
+    }
+    let tp = t.map(|v| (v + (1 << 24)) >> 25); // T' = round(T / 2^25) in [2^31, 2^36]
+    let tp_max = tp[0].max(tp[1]).max(tp[2]);
+    let Some(sh) = 63u32.checked_sub(bits(area2) + bits(tp_max)) else {
+        return Ok(None);
+    };
+    // K = 65535 2A = kn 2^kz, kn in [2^31, 2^32) rounded to nearest.
+    let k = 65535 * area2;
+    let kb = bits(k) as i32;
+    let (kn, kz) = if kb > 32 {
+        let r = (k + (1 << (kb - 33))) >> (kb - 32);
+        if r >> 32 != 0 {
+            (r >> 1, kb - 31)
+        } else {
+            (r, kb - 32)
+        }
+    } else {
+        (k << (32 - kb), kb - 32)
+    };
+    let s0 = 86 - kz - s.frac as i32 - sh as i32; // the code's shift is s0 - lz, lz >= 1
+    if s0 > 32 {
+        return Ok(None);
+    }
+    let (kn, s0) = (kn as u32, s0 as u32);
+
+    // Edges k -> k+1, opposite vertex k+2: E = A (x - x_k) + B (y - y_k) - bias.
+    let edge = |a: (i32, i32), b: (i32, i32)| {
+        let (ea, eb) = (a.1 - b.1, b.0 - a.0);
+        let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0)));
+        (ea, eb, a, bias)
+    };
+    let edges = [edge(q[0], q[1]), edge(q[1], q[2]), edge(q[2], q[0])];
+    // S weights: edge k carries T' of vertex k + 2.
+    let w = [tp[2], tp[0], tp[1]];
+
+    // Rows and columns whose centres lie in the box, clipped to the buffer.
+    let (j_first, j_last) = rows_of(&p);
+    let j0 = j_first.max(depth.y0());
+    let j1 = j_last.min(depth.y0() + depth.height() as i32 - 1);
+    let i_first = (xmin - 128 + 255) >> SUBPIXEL_BITS; // ceil((xmin - 128) / 256)
+    let i0 = i_first.max(0);
+    let i1 = ((xmax - 128) >> SUBPIXEL_BITS).min(depth.width() as i32 - 1);
+    let mut stats = Stats::default();
+    if j0 > j1 || i0 > i1 {
+        return Ok(Some(stats));
+    }
+    let ncol = (i1 - i0 + 1) as usize;
+    // The edge functions and S at the centre of (i0, j0), and their steps per column and row.
+    let (cx, cy) = (
+        ((i0 - ox) << SUBPIXEL_BITS) + 128,
+        ((j0 - oy) << SUBPIXEL_BITS) + 128,
+    );
+    let mut er = [0i32; 3];
+    let (mut sr, mut sx, mut sy) = (0u64, 0u64, 0u64);
+    let mut ex = [0i32; 3];
+    let mut ey = [0i32; 3];
+    for k in 0..3 {
+        let (ea, eb, a, bias) = edges[k];
+        er[k] = ea * (cx - a.0) + eb * (cy - a.1) - bias;
+        ex[k] = ea << SUBPIXEL_BITS;
+        ey[k] = eb << SUBPIXEL_BITS;
+        sr = sr.wrapping_add((er[k] as i64 + bias as i64).wrapping_mul(w[k] as i64) as u64);
+        sx = sx.wrapping_add((ex[k] as i64).wrapping_mul(w[k] as i64) as u64);
+        sy = sy.wrapping_add((ey[k] as i64).wrapping_mul(w[k] as i64) as u64);
+    }
+    let (sr, sx, sy) = (sr << sh, sx << sh, sy << sh);
+
+    let (mut sr, mut er) = (sr, er);
+    for j in j0..=j1 {
+        let row = &mut depth.row_mut(j)[i0 as usize..=i1 as usize];
+        let [mut e0, mut e1, mut e2] = er;
+        let mut v = sr;
+        let mut k = 0usize;
+        while k < ncol && (e0 | e1 | e2) < 0 {
+            e0 += ex[0];
+            e1 += ex[1];
+            e2 += ex[2];
+            v = v.wrapping_add(sx);
+            k += 1;
+        }
+        let lo = k;
+        // The covered run: edges only (the triangle is convex), then the depth loop over it with few live values.
+        while k < ncol && (e0 | e1 | e2) >= 0 {
+            e0 += ex[0];
+            e1 += ex[1];
+            e2 += ex[2];
+            k += 1;
+        }
+        // Bit `n - 1 - i` for the run's pixel `i`.
+        let mut pass = 0u32;
+        for stored in row[lo..k].iter_mut() {
+            let h = (v >> 32) as u32;
+            let lz = lz_small(h);
+            let m = (h << lz) | ((v as u32) >> (32 - lz));
+            let hi = ((kn as u64 * fresh61(m) as u32 as u64) >> 32) as u32;
+            let c = (((hi >> (s0 - lz - 1)) + 1) >> 1) as u16;
+            let ok = c < *stored;
+            if ok {
+                *stored = c;
+            }
+            pass = (pass << 1) | u32::from(ok);
+            v = v.wrapping_add(sx);
+        }
+        let n = (k - lo) as u32;
+        if n > 0 {
+            stats.fragments += n;
+            stats.written += emit(target, i0 + lo as i32, j, n, pass, color)?;
+        }
+        for (e, d) in er.iter_mut().zip(ey) {
+            *e += d;
+        }
+        sr = sr.wrapping_add(sy);
+    }
+    Ok(Some(stats))
 }
 
-/// `T` at `di` columns right of the plane's reference column, `0 <= di < 2^7` (a small triangle's box): the
-/// wrapping `row + sx di` of [`Plane::at`] from two 16-bit halves of `sx`'s low word (each product below `2^23`)
-/// and its high word, so no 64-bit multiply (a library call on the Cortex-M0).
-#[inline(always)]
-fn at_small(t: &Plane, di: u32) -> u64 {
-    debug_assert!(di < 1 << 7);
-    let sx = t.sx as u64;
-    let (lo, hi) = (sx as u32, (sx >> 32) as u32);
-    let low = ((((lo >> 16) * di) as u64) << 16) + ((lo & 0xffff) * di) as u64;
-    (t.row as u64)
-        .wrapping_add(low)
-        .wrapping_add((hi.wrapping_mul(di) as u64) << 32)
-}
-
-/// The passing runs of a chunk of `n <= 32` pixels from column `x0` of row `j`: bit `n - 1 - k` of `pass` set for a
-/// written pixel `x0 + k`. Returns how many were written.
+/// The passing runs of a run of `n <= 32` covered pixels from column `x0` of row `j`: bit `n - 1 - k` of `pass` set
+/// for a written pixel `x0 + k`. Returns how many were written.
 #[inline(always)]
 fn emit<D: DrawTarget>(
     target: &mut D,
@@ -149,28 +262,4 @@ fn emit<D: DrawTarget>(
         at += skip + len;
     }
     Ok(pass.count_ones())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `at_small` is `Plane::at` for every column offset of a small box, on planes of any sign and size.
-    #[test]
-    fn at_small_is_the_plane() {
-        let mut s = 0x1234_5678_9ABC_DEF1u64;
-        for _ in 0..20_000 {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            let p = Plane {
-                row: s as i64,
-                sx: (s.rotate_left(17) as i64) >> (s % 40),
-                sy: 0,
-            };
-            for di in 0..128u32 {
-                assert_eq!(at_small(&p, di), p.at(di as i64) as u64);
-            }
-        }
-    }
 }

@@ -160,6 +160,15 @@ pub struct RenderState {
 }
 
 impl RenderState {
+    /// Whether a depth bias is set (feature `bias`; never without it).
+    #[inline(always)]
+    pub(crate) fn has_bias(&self) -> bool {
+        #[cfg(feature = "bias")]
+        return self.depth_bias != 0.0 || self.slope_scale_depth_bias != 0.0;
+        #[cfg(not(feature = "bias"))]
+        false
+    }
+
     /// W buffering, `Less`, depth write on, no culling, over `[w_near, w_far]`.
     pub fn new(w_near: f32, w_far: f32) -> Result<Self, Error> {
         Ok(RenderState {

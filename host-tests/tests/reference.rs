@@ -29,6 +29,20 @@ fn compare_each<R: SpanRecip>(
     wmin: f64,
     wmax: f64,
 ) -> Tally {
+    compare_each_of::<R>(cmp, seed, count, near, far, |rng| {
+        random_tri(rng, wmin, wmax)
+    })
+}
+
+/// [`compare_each`] over the triangles `tri` makes.
+fn compare_each_of<R: SpanRecip>(
+    cmp: Compare,
+    seed: u64,
+    count: usize,
+    near: f32,
+    far: f32,
+    mut tri_of: impl FnMut(&mut Rng) -> [Vertex<Rgb565>; 3],
+) -> Tally {
     let mut rng = Rng(seed);
     let mut state = RenderState::new(near, far).unwrap();
     state.compare = cmp;
@@ -40,7 +54,7 @@ fn compare_each<R: SpanRecip>(
         max_diff: 0,
     };
     for n in 0..count {
-        let tri = random_tri(&mut rng, wmin, wmax);
+        let tri = tri_of(&mut rng);
         let mut frame = Frame::new(W as u32, H as u32);
         let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
         buf.clear();
@@ -183,6 +197,70 @@ fn depth_suite<R: SpanRecip>(cmp: Compare, name: &str, bound: f64) {
 #[test]
 fn fast_tier_within_one_lsb_and_999_exact() {
     depth_suite::<wraster::recip::Fast>(Compare::Less, "fast tier", 1.0 - 2.0 * 2f64.powf(-11.1));
+}
+
+/// A random small triangle: a box of 1 to 127 px (log-uniform) anywhere over the 96 x 64 frame (so partly outside it
+/// too), vertices on sub-pixel ties or pixel centres a quarter of the time each, both windings, and depths within a
+/// factor `ratio` (log-uniform up to 64) of each other around a depth anywhere in `[wmin, wmax]`.
+fn small_tri(rng: &mut Rng, wmin: f64, wmax: f64) -> [Vertex<Rgb565>; 3] {
+    let size = rng.log(1.0, 127.0);
+    let (x0, y0) = (rng.f(-20.0, 100.0), rng.f(-20.0, 70.0));
+    let base = rng.log(wmin, wmax);
+    let ratio = rng.log(1.0, 64.0);
+    let c = Rgb565::new((rng.bits() % 32) as u8, (rng.bits() % 64) as u8, 0);
+    [0; 3].map(|_| {
+        let (mut x, mut y) = (x0 + rng.f(0.0, size), y0 + rng.f(0.0, size));
+        match rng.bits() % 4 {
+            0 => (x, y) = (x.floor() + 0.5, y.floor() + 0.5),
+            1 => {
+                (x, y) = (
+                    (x * 256.0).floor() / 256.0 + 1.0 / 512.0,
+                    (y * 256.0).floor() / 256.0 + 1.0 / 512.0,
+                )
+            }
+            _ => {}
+        }
+        Vertex::new(x as f32, y as f32, (base * rng.log(1.0, ratio)) as f32, c)
+    })
+}
+
+/// The fast tier on 100,000 small triangles (`small_tri`: boxes of 1 to 127 px, the ones its small-triangle loop
+/// takes and their neighbours) at far/near 10, 100, 1000 and 1e4, with `Less`: coverage equal to the reference on
+/// every pixel (asserted by `compare_each`: written = covered in range), every code within 1 LSB, and at least
+/// `1 - 2 * 2^-11.1 = 99.9%` exact, the fast tier's derived share (see the test below; `src/small.rs` derives its
+/// loop's `5.9e-9`, inside the tier's `2^-27.2`).
+#[test]
+fn fast_tier_small_triangles_cover_and_hold_the_contract() {
+    let mut all = 0;
+    for (k, far) in [10.0f32, 100.0, 1000.0, 1.0e4].into_iter().enumerate() {
+        let t = compare_each_of::<wraster::recip::Fast>(
+            Compare::Less,
+            900 + k as u64,
+            25_000,
+            1.0,
+            far,
+            |rng| small_tri(rng, 0.8, far as f64 * 1.25),
+        );
+        let frac = t.exact as f64 / t.pixels as f64;
+        println!(
+            "fast tier, small triangles, far/near={far}: {} pixels, {} exact ({:.5}%), max diff {}",
+            t.pixels,
+            t.exact,
+            100.0 * frac,
+            t.max_diff
+        );
+        assert!(
+            t.pixels > 400_000,
+            "the sweep must cover many pixels: {}",
+            t.pixels
+        );
+        assert!(
+            frac >= 1.0 - 2.0 * 2f64.powf(-11.1),
+            "far/near {far}: only {frac} exact"
+        );
+        all += t.pixels;
+    }
+    println!("fast tier, small triangles: {all} pixels over 100,000 triangles");
 }
 
 /// The previous-pixel seed: bound 2^-21.98 (recip.rs), so codes err by at most 65535 * 2^-21.98 < 2^-5.9 LSB:
