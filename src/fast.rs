@@ -145,7 +145,7 @@ fn newton<const UP: bool>(tau: u32, xs: i32) -> i32 {
 
 /// The high word of the 64-bit product (`UMULL` where the core has it).
 #[inline(always)]
-fn mul_hi(a: u32, b: u32) -> u32 {
+pub(crate) fn mul_hi(a: u32, b: u32) -> u32 {
     #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
     return mul_hi_halves(a, b);
     #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
@@ -353,6 +353,63 @@ pub(crate) fn lz_small(h: u32) -> u32 {
     return h.leading_zeros();
 }
 
+/// The bits of `v` (`64 - leading_zeros`, 0 for 0), for set-up code. ARMv6-M (Cortex-M0) and RV32IMAC have no
+/// count-leading-zeros instruction: `leading_zeros` is a library call there (`__clzsi2`, about 35 instructions, two of
+/// them for a `u64`), so they take a six-step binary search inline (tested against `leading_zeros`).
+#[inline(always)]
+pub(crate) fn bits64(v: u64) -> u32 {
+    #[cfg(any(
+        all(target_arch = "arm", not(target_has_atomic = "32")),
+        target_arch = "riscv32"
+    ))]
+    return bits_search(v);
+    #[cfg(not(any(
+        all(target_arch = "arm", not(target_has_atomic = "32")),
+        target_arch = "riscv32"
+    )))]
+    return 64 - v.leading_zeros();
+}
+
+#[cfg_attr(
+    not(any(
+        all(target_arch = "arm", not(target_has_atomic = "32")),
+        target_arch = "riscv32"
+    )),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn bits_search(v: u64) -> u32 {
+    let (mut x, mut n) = if v >> 32 != 0 {
+        ((v >> 32) as u32, 32)
+    } else {
+        (v as u32, 0)
+    };
+    if x >> 16 != 0 {
+        x >>= 16;
+        n += 16;
+    }
+    if x >> 8 != 0 {
+        x >>= 8;
+        n += 8;
+    }
+    if x >> 4 != 0 {
+        x >>= 4;
+        n += 4;
+    }
+    if x >> 2 != 0 {
+        x >>= 2;
+        n += 2;
+    }
+    n + x.min(2) // x in 0..=3, whose bits are 0, 1, 2, 2
+}
+
+/// The exact 64-bit product of two `u32`: the high word by [`mul_hi`] (four `MULS` on the Cortex-M0 instead of the
+/// `__aeabi_lmul` call), the low word by one wrapping multiply.
+#[inline(always)]
+pub(crate) fn mul_wide(a: u32, b: u32) -> u64 {
+    ((mul_hi(a, b) as u64) << 32) | a.wrapping_mul(b) as u64
+}
+
 /// The leading zeros of `h >= 2^18` (so in `[0, 13]`) by four compares of a binary search (tested against
 /// `leading_zeros` on every host).
 #[cfg_attr(
@@ -499,6 +556,38 @@ mod tests {
         }
         std::println!("fresh: worst {:.2} bits, bound 27.6", -worst.log2());
         assert!(worst <= bound, "{worst:e}");
+    }
+
+    /// The set-up's bit count and wide product equal `leading_zeros` and the `u64` product (all single bits, their
+    /// neighbours, and a million xorshift values).
+    #[test]
+    fn bits_search_and_mul_wide_are_exact() {
+        let check = |v: u64| {
+            assert_eq!(bits_search(v), 64 - v.leading_zeros(), "{v}");
+            assert_eq!(bits64(v), 64 - v.leading_zeros(), "{v}");
+            let (a, b) = (v as u32, (v >> 32) as u32);
+            assert_eq!(mul_wide(a, b), a as u64 * b as u64, "{a} {b}");
+            assert_eq!(
+                mul_hi_halves(a, b),
+                ((a as u64 * b as u64) >> 32) as u32,
+                "{a} {b}"
+            );
+        };
+        for v in [0u64, 1, 2, 3, u64::MAX] {
+            check(v);
+        }
+        for b in 0..64 {
+            for v in [1u64 << b, (1u64 << b) - 1, (1u64 << b) + 1] {
+                check(v);
+            }
+        }
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..1_000_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            check(x >> (x & 63));
+        }
     }
 
     /// The Cortex-M0's leading-zero search equals `leading_zeros` over its whole domain `[2^18, 2^32)` (every

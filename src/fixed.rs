@@ -26,7 +26,7 @@ pub(crate) fn round_shift(m: u64, e: i32) -> u64 {
     }
     if e >= 0 {
         // m * 2^e >= 2^63 when e reaches m's leading zeros.
-        if e >= m.leading_zeros() as i32 {
+        if e >= 64 - crate::fast::bits64(m) as i32 {
             return i64::MAX as u64;
         }
         m << e

@@ -60,10 +60,9 @@ fn snap(v: f32) -> Result<i32, Error> {
     let r = if s >= 26 {
         0 // m < 2^24 < 2^(s - 1): below half a unit
     } else {
-        let q = m >> s;
-        let rem = m & ((1 << s) - 1);
-        let half = 1 << (s - 1);
-        q + u32::from(rem > half || (rem == half && q & 1 == 1))
+        // Round half to even without branches: adding `half - 1` carries into the quotient exactly when the
+        // remainder is above half, and the quotient's low bit makes a tie carry only from an odd quotient.
+        (m + (1 << (s - 1)) - 1 + ((m >> s) & 1)) >> s
     } as i32;
     Ok(if bits >> 31 != 0 { -r } else { r })
 }

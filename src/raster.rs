@@ -93,9 +93,9 @@ pub(crate) struct Setup<const N: usize = 3> {
 #[inline(never)]
 fn t_of(rhw: (u32, i32), far: (u32, i32)) -> Result<(u64, i32), Error> {
     let (m, e) = rhw;
-    let pm = m as u64 * far.0 as u64;
+    let pm = crate::fast::mul_wide(m, far.0);
     let pe = e + far.1;
-    if 64 - pm.leading_zeros() as i32 + pe > MAX_T_LOG2 {
+    if crate::fast::bits64(pm) as i32 + pe > MAX_T_LOG2 {
         return Err(Error::DepthRange);
     }
     Ok((pm, pe))
@@ -105,8 +105,9 @@ fn t_of(rhw: (u32, i32), far: (u32, i32)) -> Result<(u64, i32), Error> {
 pub(crate) fn rows_of(p: &[Sub; 3]) -> (i32, i32) {
     let ymin = p[0].y.min(p[1].y).min(p[2].y);
     let ymax = p[0].y.max(p[1].y).max(p[2].y);
-    let first = (ymin as i64 - 128 + 255).div_euclid(256) as i32; // ceil((ymin - 128) / 256)
-    let last = (ymax as i64 - 128).div_euclid(256) as i32;
+    // |y| < 2^20 sub-pixels (the guard band): no overflow in i32, and `>>` is the floor division.
+    let first = (ymin - 128 + 255) >> SUBPIXEL_BITS; // ceil((ymin - 128) / 256)
+    let last = (ymax - 128) >> SUBPIXEL_BITS;
     (first, last)
 }
 
@@ -170,7 +171,7 @@ impl<R: WSpan> Rasterizer<R> {
         // F = 61 - bits(floor(t_max)), t_max < 2^30.
         let int_bits = tm
             .iter()
-            .map(|&(m, e)| (64 - m.leading_zeros() as i32 + e).max(0))
+            .map(|&(m, e)| (crate::fast::bits64(m) as i32 + e).max(0))
             .max()
             .unwrap_or(0);
         let frac = (61 - int_bits) as u32;

@@ -46,7 +46,7 @@ use embedded_graphics_core::primitives::Rectangle;
 use crate::depth::DepthBuffer;
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
-use crate::fast::{fresh61, lz_small, MIN_SPAN};
+use crate::fast::{fresh61, lz_small, mul_hi, mul_wide, MIN_SPAN};
 use crate::raster::{rows_of, Setup, Stats, SUBPIXEL_BITS};
 use crate::state::{Cull, RenderState};
 use crate::Error;
@@ -58,11 +58,7 @@ fn margin(t_max: u64) -> u64 {
     (t_max >> 32) + (1 << 17)
 }
 
-/// Bits of `v` (0 for 0).
-#[inline(always)]
-fn bits(v: u64) -> u32 {
-    64 - v.leading_zeros()
-}
+use crate::fast::bits64 as bits;
 
 /// Draws the snapped triangle `s` in `color` if it is a small triangle this path takes (see the module doc), with
 /// `Less`, depth write and no bias (the caller's conditions). `Ok(None)`, having written nothing, where it does not
@@ -122,7 +118,7 @@ pub(crate) fn draw<D: DrawTarget>(
         return Ok(None);
     };
     // K = 65535 2A = kn 2^kz, kn in [2^31, 2^32) rounded to nearest.
-    let k = 65535 * area2;
+    let k = mul_wide(65535, area2 as u32); // area2 < 2^27 (box under 8 x 126 px)
     let kb = bits(k) as i32;
     let (kn, kz) = if kb > 32 {
         let r = (k + (1 << (kb - 33))) >> (kb - 32);
@@ -209,7 +205,7 @@ pub(crate) fn draw<D: DrawTarget>(
             let h = (v >> 32) as u32;
             let lz = lz_small(h);
             let m = (h << lz) | ((v as u32) >> (32 - lz));
-            let hi = ((kn as u64 * fresh61(m) as u32 as u64) >> 32) as u32;
+            let hi = mul_hi(kn, fresh61(m) as u32);
             let c = (((hi >> (s0 - lz - 1)) + 1) >> 1) as u16;
             let ok = c < *stored;
             if ok {
