@@ -25,6 +25,14 @@ pub trait VertexInput: sealed::Sealed + Copy {
     /// `x` and `y` on the 16.8 grid (round to nearest, ties to even), checked against [`GUARD_BAND`].
     #[doc(hidden)]
     fn snapped(&self) -> Result<(i32, i32), Error>;
+    /// Whether `x` and `y` lie on the 16.8 snap grid (then the snapped vertex is the vertex as given).
+    #[doc(hidden)]
+    fn on_snap_grid(&self) -> bool;
+    /// `x - ox` and `y - oy` on the depth grid of `bits` fraction bits (round to nearest, ties to even; see
+    /// `crate::raster::depth_grid_bits`): the positions the depth plane goes through. Only called after
+    /// [`VertexInput::snapped`] accepted the vertex, with an origin and `bits` that keep the results below `2^31`.
+    #[doc(hidden)]
+    fn depth_xy(&self, bits: u32, ox: i32, oy: i32) -> (i32, i32);
     /// `rhw` as an exact `(mantissa, exponent)` pair, `rhw = mantissa * 2^exponent`, mantissa below 2^32.
     /// `Err(NonFinite)` for NaN and infinities (and a non-finite `z`), `Err(RhwNotPositive)` for `rhw <= 0`.
     #[doc(hidden)]
@@ -67,12 +75,69 @@ fn snap(v: f32) -> Result<i32, Error> {
     Ok(if bits >> 31 != 0 { -r } else { r })
 }
 
+/// `round(v * 2^bits)`, ties to even, for a finite `|v| < GUARD_BAND` (checked by [`snap`] first) and `bits <= 31`:
+/// `v * 2^bits = m 2^(exp - 150 + bits)` with the 24-bit mantissa `m`; a left shift (exact, below `2^43`) where that
+/// exponent is not negative, else a rounded right shift as in [`snap`].
+#[inline(never)]
+fn depth_grid(v: f32, bits: u32) -> i64 {
+    const _: () = assert!(GUARD_BAND == 1 << 12);
+    let b = v.to_bits();
+    let mag = b & 0x7fff_ffff;
+    let exp = (mag >> 23) as i32;
+    if exp == 0 {
+        return 0; // zero or subnormal: far below half a grid step
+    }
+    let m = (mag & 0x7f_ffff) | 0x80_0000;
+    let sh = exp + bits as i32 - 150;
+    let r = if sh >= 0 {
+        (m as i64) << sh.min(19)
+    } else {
+        let s = (-sh) as u32;
+        if s >= 26 {
+            0
+        } else {
+            ((m + (1 << (s - 1)) - 1 + ((m >> s) & 1)) >> s) as i64
+        }
+    };
+    if b >> 31 != 0 {
+        -r
+    } else {
+        r
+    }
+}
+
+/// Whether `v * 256` is an integer (finite `v`): no mantissa bit below the snap grid's step.
+#[inline(always)]
+fn on_grid(v: f32) -> bool {
+    let mag = v.to_bits() & 0x7fff_ffff;
+    let exp = mag >> 23;
+    let m = (mag & 0x7f_ffff) | 0x80_0000;
+    match 142u32.checked_sub(exp) {
+        _ if mag == 0 => true,
+        _ if exp == 0 => false, // a nonzero subnormal
+        None | Some(0) => true,
+        Some(s) if s >= 24 => false,
+        Some(s) => m & ((1 << s) - 1) == 0,
+    }
+}
+
 impl<C> sealed::Sealed for Vertex<C> {}
 impl<C: Copy> VertexInput for Vertex<C> {
     type Color = C;
     #[inline]
     fn snapped(&self) -> Result<(i32, i32), Error> {
         Ok((snap(self.x)?, snap(self.y)?))
+    }
+    #[inline]
+    fn on_snap_grid(&self) -> bool {
+        on_grid(self.x) && on_grid(self.y)
+    }
+    #[inline]
+    fn depth_xy(&self, bits: u32, ox: i32, oy: i32) -> (i32, i32) {
+        (
+            (depth_grid(self.x, bits) - ((ox as i64) << bits)) as i32,
+            (depth_grid(self.y, bits) - ((oy as i64) << bits)) as i32,
+        )
     }
     #[inline]
     fn rhw_exact(&self) -> Result<(u32, i32), Error> {
@@ -156,6 +221,19 @@ impl<C: Copy, R: Fixed<Bits = u32>> VertexInput for FixedVertex<C, R> {
         Ok((x, y))
     }
     #[inline]
+    fn on_snap_grid(&self) -> bool {
+        true
+    }
+    #[inline]
+    fn depth_xy(&self, bits: u32, ox: i32, oy: i32) -> (i32, i32) {
+        // On the snap grid, which the depth grid refines (bits >= 8): exact.
+        let up = bits - SUBPIXEL_BITS;
+        (
+            ((self.x.to_bits() as i64 - ((ox as i64) << SUBPIXEL_BITS)) << up) as i32,
+            ((self.y.to_bits() as i64 - ((oy as i64) << SUBPIXEL_BITS)) << up) as i32,
+        )
+    }
+    #[inline]
     fn rhw_exact(&self) -> Result<(u32, i32), Error> {
         match self.rhw.to_bits() {
             0 => Err(Error::RhwNotPositive),
@@ -214,6 +292,51 @@ mod tests {
             s ^= s << 5;
             check(f32::from_bits(s));
             check(f32::from_bits(s & 0x45ff_ffff)); // mostly inside the guard band
+        }
+    }
+
+    /// The depth grid equals the general exact conversion at every width it takes (17 to 29 fraction bits) wherever
+    /// `snap` accepts the value (every exponent, the grid's ties, random bits), a value on the 1/256 grid lands on
+    /// `snap << (bits - 8)`, and `on_grid` says exactly when the snap is exact.
+    #[test]
+    fn depth_grid_equals_the_exact_conversion() {
+        let check = |v: f32| {
+            if let Ok(sn) = snap(v) {
+                for bits in 17..=29 {
+                    let want = crate::fixed::to_fixed(v, bits, 12).unwrap();
+                    assert_eq!(
+                        depth_grid(v, bits as u32),
+                        want,
+                        "{v:e} ({:#x}) {bits}",
+                        v.to_bits()
+                    );
+                }
+                // v * 256 is exact in f64 (an f32 times a power of two).
+                let exact = v as f64 * 256.0 == sn as f64;
+                assert_eq!(on_grid(v), exact, "{v:e}");
+            }
+        };
+        for exp in 0..=255u32 {
+            for frac in [
+                0, 1, 2, 3, 0x40_0000, 0x40_0001, 0x3f_ffff, 0x7f_ffff, 0x7f_fffe, 0x7f_ff00,
+            ] {
+                for sign in [0, 1u32 << 31] {
+                    check(f32::from_bits(sign | exp << 23 | frac));
+                }
+            }
+        }
+        for k in -(1i32 << 16)..(1 << 16) {
+            check(k as f32 / (1 << 19) as f32); // ties of the 18-bit grid near 0
+            check(k as f32 / (1 << 24) as f32 + 0.25); // and of finer grids
+            check(k as f32 / 256.0); // the snap grid
+        }
+        let mut s = 0x2545_F491u32;
+        for _ in 0..200_000 {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            check(f32::from_bits(s));
+            check(f32::from_bits(s & 0x45ff_ffff));
         }
     }
 }

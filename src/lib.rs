@@ -138,5 +138,7 @@ pub use depth::{DepthBuffer, DepthStore, W16_FAR};
 pub use error::Error;
 pub use input::{FixedVertex, VertexInput};
 pub use packed::{Codec, Packed, Resolved};
-pub use raster::{row_range, Rasterizer, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS};
+pub use raster::{
+    depth_grid_bits, row_range, Rasterizer, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS,
+};
 pub use state::{Compare, Cull, DepthMode, DepthRange, RenderState, MAX_T};

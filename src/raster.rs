@@ -8,7 +8,19 @@
 //! The plane is solved exactly in `i128` at setup: the per-pixel steps and the value at a reference pixel are each
 //! rounded to nearest, so at a pixel `k` columns and `l` rows from the reference `T` errs by at most
 //! `(1 + k + l) / 2` units of `2^-F`. Steps are added with wrapping arithmetic: for a sliver the plane's slope may
-//! exceed `i64`, but every covered pixel's true `T` lies in `[0, 2^61]`, so the wrapped sum is right modulo `2^64`.
+//! exceed `i64`, but every covered pixel's true `T` lies in `(-2^61, 2^62)` (see `depth_plane`), so the wrapped sum
+//! is right modulo `2^64`, and the range test rejects whatever lies outside `[2^F, T_near]`.
+//!
+//! Which vertices. Coverage uses the vertices snapped to 1/256 px (the fill rule needs exact edge functions). The
+//! depth plane (and the colour planes) go through the vertices **as given**: rounded only to a depth grid of
+//! [`depth_grid_bits`] fraction bits (`2^-17` px for a box as large as the guard band, `2^-24` for one under 126 px,
+//! `2^-29` within a pixel), exact for every f32 coordinate of magnitude `2^(23 - bits)` px or more. Through the snapped
+//! vertices instead, the depth of a grazing plane moved by many codes (up to 127 on world-space triangles); through
+//! the grid, a covered pixel's `t` differs from the true surface's by at most
+//! `sum_k |lambda_k| |grad t . (q_k - v_k)|` (`q_k` the grid positions, `v_k` the given ones, `lambda_k` the pixel's
+//! barycentrics): zero for vertices on the snap grid (then the snapped plane is this plane, and nothing extra runs),
+//! below `1.3e-4` codes on the grazing tests. The fast tier gets the same plane without a second solve: its `T` at the
+//! snapped vertices ([`t_at_snapped`]), through which its own set-ups solve.
 
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::PixelColor;
@@ -28,8 +40,19 @@ use crate::Error;
 #[cfg(feature = "gouraud")]
 use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
 
-/// Fraction bits of snapped x and y (Direct3D 11's 16.8).
+/// Fraction bits of snapped x and y (Direct3D 11's 16.8): coverage (the edge functions) uses the snapped vertices.
 pub const SUBPIXEL_BITS: u32 = 8;
+
+/// Fraction bits of the depth grid of a triangle whose snapped box spans `extent` whole pixels (its larger side,
+/// `0..=8192`): `31 - bits(extent + 2)`, from 29 (a box within one pixel) down to 17 (the guard band). The depth plane
+/// (and the colour planes) go through the vertices as given, rounded to this grid relative to the box's first pixel,
+/// not through the snapped ones: positions then fit 31 bits (the exact plane solve's budget). An f32 coordinate of
+/// magnitude `2^(23 - bits)` px or more lies on the grid exactly (`2^-6` px for a box under 6 px, 64 px for the
+/// largest boxes); a smaller one moves by at most half a grid step. Vertices on the 16.8 snap grid (integer and
+/// fixed-point input, most meshes' pixel-aligned vertices) give the same plane either way and skip this.
+pub const fn depth_grid_bits(extent: i32) -> u32 {
+    31 - (32 - ((extent + 2) as u32).leading_zeros())
+}
 /// Vertices must have `|x|, |y| < GUARD_BAND` pixels (see ARCHITECTURE.md for why this is safe in i64).
 pub const GUARD_BAND: i32 = 4096;
 
@@ -84,7 +107,17 @@ impl core::ops::AddAssign for Stats {
 
 /// A triangle after snapping and checks.
 pub(crate) struct Setup<const N: usize = 3> {
+    /// Snapped positions (coverage).
     pub(crate) p: [Sub; N],
+    /// Whether every vertex lies on the snap grid: then `p` is the vertices as given, and `q` is not computed.
+    pub(crate) on_grid: bool,
+    /// Otherwise (triangles): positions on the depth grid of `dbits` fraction bits ([`depth_grid_bits`]) relative
+    /// to the pixel `dorigin` (the box's first column and row).
+    pub(crate) q: [Sub; N],
+    pub(crate) dbits: u32,
+    pub(crate) dorigin: (i32, i32),
+    /// The fast tier's depth-grid plane `T` at the snapped vertices ([`t_at_snapped`]), where computed and accepted.
+    pub(crate) fast_t: Option<[i64; 3]>,
     pub(crate) t: [i64; N],
     pub(crate) frac: u32,
 }
@@ -161,12 +194,30 @@ impl<R: WSpan> Rasterizer<R> {
     ) -> Result<Setup<N>, Error> {
         let (_, fm, fe) = split(self.state.range.far()).ok_or(Error::NonFinite)?;
         let mut p = [Sub { x: 0, y: 0 }; N];
+        let mut on_grid = true;
         let mut tm = [(0u64, 0i32); N];
         for k in 0..N {
             let r = v[k].rhw_exact()?;
             let (x, y) = v[k].snapped()?;
             p[k] = Sub { x, y };
+            on_grid &= v[k].on_snap_grid();
             tm[k] = t_of(r, (fm, fe))?;
+        }
+        let mut q = [Sub { x: 0, y: 0 }; N];
+        let (mut dbits, mut dorigin) = (SUBPIXEL_BITS, (0, 0));
+        if N == 3 && !on_grid {
+            let (ox, oy) = (
+                p.iter().map(|s| s.x).min().unwrap_or(0) >> SUBPIXEL_BITS,
+                p.iter().map(|s| s.y).min().unwrap_or(0) >> SUBPIXEL_BITS,
+            );
+            let xe = (p.iter().map(|s| s.x).max().unwrap_or(0) >> SUBPIXEL_BITS) - ox;
+            let ye = (p.iter().map(|s| s.y).max().unwrap_or(0) >> SUBPIXEL_BITS) - oy;
+            dbits = depth_grid_bits(xe.max(ye));
+            dorigin = (ox, oy);
+            for k in 0..N {
+                let (x, y) = v[k].depth_xy(dbits, ox, oy);
+                q[k] = Sub { x, y };
+            }
         }
         // F = 61 - bits(floor(t_max)), t_max < 2^30.
         let int_bits = tm
@@ -176,7 +227,16 @@ impl<R: WSpan> Rasterizer<R> {
             .unwrap_or(0);
         let frac = (61 - int_bits) as u32;
         let t = tm.map(|(m, e)| round_shift(m, e + frac as i32) as i64);
-        Ok(Setup { p, t, frac })
+        Ok(Setup {
+            p,
+            on_grid,
+            q,
+            dbits,
+            dorigin,
+            fast_t: None,
+            t,
+            frac,
+        })
     }
 
     /// Snaps, checks, culls and clips a triangle to the buffer's rows, and solves its `t` plane.
@@ -225,21 +285,64 @@ impl<R: WSpan> Rasterizer<R> {
         }
         let xmin = p[0].x.min(p[1].x).min(p[2].x);
         let ymin = p[0].y.min(p[1].y).min(p[2].y);
-        let geom = Geom {
-            p,
-            area: area.unsigned_abs() as i128,
-            i_ref: (xmin >> SUBPIXEL_BITS) as i64,
-            j_ref: j_first,
-            j0,
-        };
-        let t_or = order.map(|k| s.t[k]);
+        let mut t_or = order.map(|k| s.t[k]);
+        let mut frac = s.frac;
+        let area = area.unsigned_abs() as i128;
+        let snapped_plane = (p, area, SUBPIXEL_BITS, (0, 0));
         // Small: every vertex within 127 px (minus a pixel for the origin's offset) of the box's origin pixel.
         let small = fast && {
             let xmax = p[0].x.max(p[1].x).max(p[2].x);
             let ymax = p[0].y.max(p[1].y).max(p[2].y);
             xmax - xmin < 126 << SUBPIXEL_BITS && ymax - ymin < 126 << SUBPIXEL_BITS
         };
-        let fast_plane = if small {
+        // The fast set-up solves through the snapped vertices, with the depth-grid plane's `T` there off the grid.
+        let at_snapped = match small {
+            true if !s.on_grid => s.fast_t.map(|t| order.map(|k| t[k])),
+            _ => None,
+        };
+        if let Some(tv) = at_snapped {
+            t_or = tv;
+        }
+        let (dq, darea, dbits, dorigin) = if s.on_grid || at_snapped.is_some() {
+            snapped_plane
+        } else {
+            let q = order.map(|k| s.q[k]);
+            // A sliver whose extrapolation needs more headroom is solved with fewer fraction bits (see
+            // `depth_plane`); the snapped plane only for a degenerate depth-grid triangle or an absurd sliver.
+            let mut plane = None;
+            for _ in 0..4 {
+                match depth_plane(&p, &q, &t_or, s.dbits, s.dorigin) {
+                    Ok(a) => {
+                        plane = Some((q, a, s.dbits, s.dorigin));
+                        break;
+                    }
+                    Err(Some(e)) if frac > e + MIN_FRAC => {
+                        t_or = t_or.map(|t| round_shift(t as u64, -(e as i32)) as i64);
+                        frac -= e;
+                    }
+                    Err(_) => break,
+                }
+            }
+            match plane {
+                Some(pl) => pl,
+                None => {
+                    (t_or, frac) = (order.map(|k| s.t[k]), s.frac);
+                    snapped_plane
+                }
+            }
+        };
+        let geom = Geom {
+            p,
+            area,
+            dq,
+            darea,
+            dbits,
+            dorigin,
+            i_ref: (xmin >> SUBPIXEL_BITS) as i64,
+            j_ref: j_first,
+            j0,
+        };
+        let fast_plane = if small && (s.on_grid || at_snapped.is_some()) {
             Plane::solve_fast(t_or, &geom)
         } else {
             None
@@ -264,7 +367,7 @@ impl<R: WSpan> Rasterizer<R> {
         };
         let exact = edges.iter().map(Edge::rows_exact).min().unwrap_or(1 << 24);
         Ok(Ok(Walk {
-            frac: s.frac,
+            frac,
             t_vertex: t_or,
             edges,
             j: j0,
@@ -275,9 +378,9 @@ impl<R: WSpan> Rasterizer<R> {
             j1,
             t,
             span: SpanCtx {
-                t_lo: 1u64 << s.frac,
-                t_hi: self.state.range.t_max(s.frac),
-                shift_base: 94 - s.frac,
+                t_lo: 1u64 << frac,
+                t_hi: self.state.range.t_max(frac),
+                shift_base: 94 - frac,
                 #[cfg(feature = "bias")]
                 bias: bias_of(&self.state, &s.p, &s.t, s.frac),
             },
@@ -309,7 +412,10 @@ impl<R: SpanRecip> Rasterizer<R> {
         D::Color: PixelColor,
     {
         let (cmp, write) = self.w16_test()?;
-        let s = self.setup(v)?;
+        let mut s = self.setup(v)?;
+        if R::FAST_W16 && !s.on_grid {
+            s.fast_t = t_at_snapped(&s);
+        }
         if R::FAST_W16 && cmp == Compare::Less && write && !self.state.has_bias() {
             if let Some(stats) = crate::small::draw(target, depth, &s, &self.state, v[0].color())? {
                 return Ok(stats);
@@ -366,7 +472,6 @@ impl<R: SpanRecip> Rasterizer<R> {
         D::Color: PixelColor + From<Rgb888> + Into<Rgb888>,
     {
         let (cmp, write) = self.w16_test()?;
-        let s_t = self.setup(v)?.t;
         let mut w = match self.prepare(v, (depth.y0(), depth.height()), false)? {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
@@ -376,8 +481,13 @@ impl<R: SpanRecip> Rasterizer<R> {
             let c: Rgb888 = q.color().into();
             [c.r(), c.g(), c.b()]
         });
-        let mut planes = [0, 1, 2]
-            .map(|ch| Plane::solve(w.order.map(|k| rgb[k][ch] as i64 * (s_t[k] >> 8)), &w.geom));
+        // From the walk's `T` (oriented; with the walk's fraction bits, which a sliver may reduce).
+        let mut planes = [0, 1, 2].map(|ch| {
+            Plane::solve(
+                [0, 1, 2].map(|j| rgb[w.order[j]][ch] as i64 * (w.t_vertex[j] >> 8)),
+                &w.geom,
+            )
+        });
         let mut buf = [D::Color::from(Rgb888::BLACK); 32];
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {
@@ -406,7 +516,9 @@ impl<R: SpanRecip> Rasterizer<R> {
                             pass = true;
                             // c = 256 Q / T = q x 2^-54 with q = (Q << lz) >> 32 (ARCHITECTURE.md)
                             let ch = q.map(|qq| {
-                                let qn = ((qq.max(0) as u64) << inv.lz) >> 32;
+                                // Clamped to [0, T]: a pixel just outside the depth-grid triangle takes
+                                // extrapolated planes (see `depth_plane`), and `Q <= T` keeps `Q << lz` in range.
+                                let qn = ((qq.clamp(0, t as i64) as u64) << inv.lz) >> 32;
                                 ((qn * inv.x as u64 + (1 << 53)) >> 54).min(255) as u8
                             });
                             buf[n] = D::Color::from(Rgb888::new(ch[0], ch[1], ch[2]));
@@ -457,12 +569,158 @@ impl<R: SpanRecip> Rasterizer<R> {
 /// whole, codes and range tests included. (A fuzz finding: with the planes rounded at each band's first row, pixels
 /// exactly on the near plane flipped between bands.)
 pub(crate) struct Geom {
+    /// Snapped positions (coverage; and the bias's slope), and their doubled area (positive).
     pub(crate) p: [Sub; 3],
     pub(crate) area: i128,
+    /// The positions the planes go through, in units of `2^-dbits` px from the pixel `dorigin`, and their doubled
+    /// signed area in those units
+    /// (nonzero; negative when rounding flipped the triangle against `p`'s orientation): the depth grid's, or the
+    /// snapped ones where the vertices lie on the snap grid or [`depth_plane`] refuses.
+    pub(crate) dq: [Sub; 3],
+    pub(crate) darea: i128,
+    pub(crate) dbits: u32,
+    /// The pixel `dq` is relative to.
+    pub(crate) dorigin: (i32, i32),
     pub(crate) i_ref: i64,
     pub(crate) j_ref: i32,
     pub(crate) j0: i32,
 }
+
+/// The doubled signed area of the depth-grid triangle `q` (oriented like `p`), if the plane of `t` through it can be
+/// walked: `None` when `q` is degenerate, or when a covered pixel could take a `T` beyond `2^62` in magnitude.
+///
+/// A covered pixel lies in the snapped triangle `p`, so it is a convex combination of the `p_k = q_k - r_k` (`r_k`
+/// the rounding of the snap against the depth grid): `P = Q - R` with `Q` in `q`'s triangle and each coordinate of
+/// `R` at most `r = max |r_k|`. So its `T` is within `(|T_x| + |T_y|) r` of a value in `[T_min, T_max]` (`T_x`, `T_y`
+/// the plane's gradient per grid unit). Accepted when `(|gx| + |gy|) r <= 2^61 |area|` (`T < 2^61`): every covered
+/// pixel's `T` then lies in `(-2^61, 2^62)` and its walked value is exact modulo `2^64` (module doc); the range test
+/// rejects the extrapolated pixels whose `T` leaves `[2^F, T_near]`. Otherwise `Err(Some(e))`: with `T` shifted
+/// right by `e` bits (`F - e` fraction bits, the plane's rounding then `2^e` times coarser) it is accepted; `Err(None)`
+/// for a degenerate `q`. Ranges: positions below `2^31` units (the
+/// grid's choice), so differences below `2^31`, `|g| < 2^93`, `r <= 2^(bits - 9) < 2^21`, `|area| < 2^63`.
+fn depth_plane(
+    p: &[Sub; 3],
+    q: &[Sub; 3],
+    t: &[i64; 3],
+    bits: u32,
+    (ox, oy): (i32, i32),
+) -> Result<i128, Option<u32>> {
+    let up = bits - SUBPIXEL_BITS;
+    let [q0, q1, q2] = *q;
+    let (e1x, e1y) = ((q1.x - q0.x) as i128, (q1.y - q0.y) as i128);
+    let (e2x, e2y) = ((q2.x - q0.x) as i128, (q2.y - q0.y) as i128);
+    let area = e1x * e2y - e2x * e1y;
+    if area == 0 {
+        return Err(None);
+    }
+    let (d1, d2) = (t[1] as i128 - t[0] as i128, t[2] as i128 - t[0] as i128);
+    let gx = d1 * e2y - d2 * e1y;
+    let gy = d2 * e1x - d1 * e2x;
+    let r = (0..3)
+        .map(|k| {
+            let rx = q[k].x as i64 - ((p[k].x as i64 - ((ox as i64) << SUBPIXEL_BITS)) << up);
+            let ry = q[k].y as i64 - ((p[k].y as i64 - ((oy as i64) << SUBPIXEL_BITS)) << up);
+            let (rx, ry) = (rx.unsigned_abs(), ry.unsigned_abs());
+            rx.max(ry)
+        })
+        .max()
+        .unwrap_or(0) as i128;
+    let (lhs, rhs) = ((gx.abs() + gy.abs()) * r, area.abs() << 61);
+    if lhs <= rhs {
+        return Ok(area);
+    }
+    // lhs < rhs 2^e; one more bit for the rounding of the shifted `T` (which moves `g` by at most `2^32`).
+    Err(Some(rhs.leading_zeros() - lhs.leading_zeros() + 2))
+}
+
+/// The fast tier's way to the depth-grid plane without solving it: its `T` at the three snapped vertices, so that the
+/// plane through `(p_k, T_q(p_k))` (what the fast set-ups solve, from the snapped positions they already have) is the
+/// depth-grid plane itself (an affine function is fixed by three points).
+///
+/// With `p_k = q_k + r_k` (`r_k` the snap's rounding against the depth grid, at most `2^(bits - 9)` units),
+/// `T_q(p_k) = t_k + c_k`, `c_k = sum over j != k of mu_jk (t_j - t_k)`, `mu_jk` the barycentric of `p_k` for `q_j`
+/// in the `q` triangle: the edge opposite `q_j` passes through `q_k`, so `mu_jk = (b - a) x r_k / A` (`a`, `b` that
+/// edge's ends, `A` the doubled area). The cross products are exact in `i64` (`|b - a| < 2^31`, `|r| < 2^21`); each
+/// term `E (t_j - t_k) / A` takes its three operands' top 32 bits (`2^-31` each) and one 32-bit reciprocal of `A`
+/// ([`fresh61`], `2^-27.6`): below `2^-26.5` of the term off. Accepted when the terms' magnitudes sum to at most
+/// `T_min / 2^9` for every `k` (a plane gentle over the snap's 1/512 px), so the corrected values err by below
+/// `T_min 2^-35`, far inside both fast set-ups' margins; `None` otherwise (the exact solve then runs). 32- and
+/// 64-bit arithmetic only (no 128-bit product: those are library calls on the 32-bit cores). Only for vertices off
+/// the snap grid.
+pub(crate) fn t_at_snapped(s: &Setup) -> Option<[i64; 3]> {
+    use crate::fast::{bits64, fresh61, mul_wide};
+    let (p, q, t) = (s.p, s.q, s.t);
+    let up = s.dbits - SUBPIXEL_BITS;
+    let (ox, oy) = (s.dorigin.0 << SUBPIXEL_BITS, s.dorigin.1 << SUBPIXEL_BITS);
+    // Edges opposite each vertex (q_(j+1) -> q_(j+2)) and the snap's rounding r_k: the snapped position relative to
+    // the box origin, on the grid, is below 2^31 (the grid's choice), and r_k below 2^21, so i32 throughout and
+    // every cross product one 32 x 32 -> 64 multiply.
+    let edge = |a: Sub, b: Sub| (b.x.wrapping_sub(a.x), b.y.wrapping_sub(a.y));
+    let ed = [edge(q[1], q[2]), edge(q[2], q[0]), edge(q[0], q[1])];
+    let r = [0, 1, 2].map(|k| {
+        (
+            ((p[k].x - ox) << up).wrapping_sub(q[k].x),
+            ((p[k].y - oy) << up).wrapping_sub(q[k].y),
+        )
+    });
+    let cross = |e: (i32, i32), v: (i32, i32)| e.0 as i64 * v.1 as i64 - e.1 as i64 * v.0 as i64;
+    let area = cross(ed[2], (q[2].x - q[0].x, q[2].y - q[0].y)); // (q1 - q0) x (q2 - q0), below 2^63
+    if area == 0 {
+        return None;
+    }
+    let a = area.unsigned_abs();
+    let la = 64 - bits64(a);
+    let m = ((a << la) >> 32) as u32; // in [2^31, 2^32)
+    let x = fresh61(m); // about 2^61 / m
+                        // v (nonzero) normalised to [2^31, 2^32) and the shift back: v is about top 2^sh, truncated by below 2^-31.
+    let top = |v: u64| {
+        let b = bits64(v) as i32;
+        let n = if b <= 32 {
+            v << (32 - b)
+        } else {
+            v >> (b - 32)
+        };
+        (n as u32, b - 32)
+    };
+    let t_min = t[0].min(t[1]).min(t[2]);
+    let lim = (t_min >> 9) as u64;
+    let mut out = t;
+    for k in 0..3 {
+        let (mut c, mut sum) = (0i64, 0u64);
+        for (j, &ej) in ed.iter().enumerate() {
+            let dt = t[j] - t[k];
+            let e = cross(ej, r[k]); // zero for j == k only by accident: its dt is zero
+            if e == 0 || dt == 0 {
+                continue;
+            }
+            // |e dt / A| = eh dh 2^(se + sd) / (m 2^(32 - la)) = (eh dh >> 32) x 2^(se + sd + la - 61).
+            let ((eh, se), (dh, sd)) = (top(e.unsigned_abs()), top(dt.unsigned_abs()));
+            let prod = (mul_wide(eh, dh) >> 32) as u32;
+            let sh = se + sd + la as i32 - 61;
+            if sh > 0 {
+                return None; // a term of 2^61 or more
+            }
+            let v = mul_wide(prod, x as u32) >> ((-sh) as u32).min(63);
+            sum += v + 1;
+            c += if (e < 0) ^ (dt < 0) ^ (area < 0) {
+                -(v as i64)
+            } else {
+                v as i64
+            };
+        }
+        if sum > lim {
+            return None;
+        }
+        out[k] = t[k] + c;
+        if out[k] >= 1 << 61 || out[k] <= 0 {
+            return None;
+        }
+    }
+    Some(out)
+}
+
+/// The fewest fraction bits a sliver's `T` is solved with (see [`depth_plane`]); below, the snapped plane.
+const MIN_FRAC: u32 = 8;
 
 /// A quantity linear in screen space: its value at `(i_ref, current row)` and its steps per column and row.
 #[derive(Clone, Copy)]
@@ -473,21 +731,29 @@ pub(crate) struct Plane {
 }
 
 impl Plane {
-    /// Solves `V(X, Y) = V0 + (gx (X - X0) + gy (Y - Y0)) / area` exactly in i128 (X, Y in sub-pixels) and rounds
-    /// the steps and the reference value once each. Steps may wrap for slivers (see the module doc).
+    /// Solves `V(X, Y) = V0 + (gx (X - X0) + gy (Y - Y0)) / area` exactly in i128 through the positions `g.dq`
+    /// (X, Y in units of `2^-dbits` px) and rounds the steps and the reference value once each. Steps may wrap for
+    /// slivers (see the module doc). Ranges (`|V| < 2^61`; positions, their differences and the offset of the
+    /// reference pixel below `2^31` units, by the choice of the grid): `|g| < 2^93`, the numerator below `2^125`,
+    /// `area < 2^63`.
     pub(crate) fn solve(v: [i64; 3], g: &Geom) -> Plane {
-        let [p0, p1, p2] = g.p;
+        let [p0, p1, p2] = g.dq;
         let (d1, d2) = (v[1] as i128 - v[0] as i128, v[2] as i128 - v[0] as i128);
-        let gx = d1 * (p2.y - p0.y) as i128 - d2 * (p1.y - p0.y) as i128;
-        let gy = d2 * (p1.x - p0.x) as i128 - d1 * (p2.x - p0.x) as i128;
+        let mut gx = d1 * (p2.y - p0.y) as i128 - d2 * (p1.y - p0.y) as i128;
+        let mut gy = d2 * (p1.x - p0.x) as i128 - d1 * (p2.x - p0.x) as i128;
+        let mut area = g.darea;
+        if area < 0 {
+            (gx, gy, area) = (-gx, -gy, -area);
+        }
+        let u = 1i128 << g.dbits;
         let (rx, ry) = (
-            256 * g.i_ref as i128 + 128 - p0.x as i128,
-            256 * g.j_ref as i128 + 128 - p0.y as i128,
+            u * (g.i_ref - g.dorigin.0 as i64) as i128 + u / 2 - p0.x as i128,
+            u * (g.j_ref - g.dorigin.1) as i128 + u / 2 - p0.y as i128,
         );
         Plane {
-            row: (v[0] as i128 + div_round(gx * rx + gy * ry, g.area)) as i64,
-            sx: div_round(gx * 256, g.area) as i64,
-            sy: div_round(gy * 256, g.area) as i64,
+            row: (v[0] as i128 + div_round(gx * rx + gy * ry, area)) as i64,
+            sx: div_round(gx * u, area) as i64,
+            sy: div_round(gy * u, area) as i64,
         }
         .at_row(g)
     }

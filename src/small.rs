@@ -26,9 +26,14 @@
 //! word: `((hi >> (s - 1)) + 1) >> 1` with `s = 86 - kz - F - sh - lz` (floors of floors). The triangle is taken when
 //! `s <= 31` at every pixel.
 //!
-//! **Error** (relative, of the computed code's value against the exact `65535 2^F / T` of the vertices' plane):
+//! **Which plane.** The `T_k` are the vertices' own where they lie on the snap grid; off it, the depth-grid plane's
+//! `T` at the snapped vertices (`crate::raster::t_at_snapped`, below `T_min 2^-35` off), so that `S` interpolates the
+//! plane through the vertices as given (to the depth grid), not the snapped ones.
+//!
+//! **Error** (relative, of the computed code's value against the exact `65535 2^F / T` of that plane):
 //! `x` `2^-27.6` ([`fresh61`]); `m` truncated below `2^-31` (`m >= 2^31`); `kn` rounded, `2^-32`; `T'` rounded, half a
-//! unit of `T'_min >= 2^31`, `2^-32`. Sum: `4.95e-9 + 0.47e-9 + 0.23e-9 + 0.23e-9 = 5.88e-9`, inside the tier's
+//! unit of `T'_min >= 2^31`, `2^-32`; the `T_k` off the grid, `2^-35`. Sum:
+//! `4.95e-9 + 0.47e-9 + 0.23e-9 + 0.23e-9 + 0.03e-9 = 5.91e-9`, inside the tier's
 //! [`FAST_MAX_REL_ERROR`] (`6.5e-9`), so the contract (every code within 1 LSB, at least 99.9% exact) holds as derived
 //! there. The code never exceeds 65535 (`65535 (1 + 5.9e-9) < 65535.5`).
 //!
@@ -71,6 +76,16 @@ pub(crate) fn draw<D: DrawTarget>(
     state: &RenderState,
     color: D::Color,
 ) -> Result<Option<Stats>, Error> {
+    // The depth-grid plane's `T` at the snapped vertices (the vertices' own where they lie on the snap grid): the
+    // barycentric sum over the snapped triangle below is then the depth-grid plane.
+    let st = if s.on_grid {
+        s.t
+    } else {
+        match s.fast_t {
+            Some(t) => t,
+            None => return Ok(None),
+        }
+    };
     let p = s.p;
     let (xmin, xmax) = (
         p[0].x.min(p[1].x).min(p[2].x),
@@ -98,9 +113,9 @@ pub(crate) fn draw<D: DrawTarget>(
         _ => {}
     }
     let (q, t) = if area < 0 {
-        ([q[0], q[2], q[1]], [s.t[0], s.t[2], s.t[1]])
+        ([q[0], q[2], q[1]], [st[0], st[2], st[1]])
     } else {
-        (q, s.t)
+        (q, st)
     };
     let area2 = area.unsigned_abs() as u64;
 

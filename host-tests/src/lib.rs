@@ -1,9 +1,12 @@
 //! Host-side tools for wraster: a checked framebuffer, the independent f64 reference rasterizer, render helpers.
 //!
-//! The reference shares with the core only the rules and the snapped vertices: snapping (round to nearest, ties to
-//! even, 8 bits), the top-left rule and the W16 encoding `round(W / W_far * 65535)`. Its arithmetic is its own:
-//! coverage by evaluating the three edge functions at every pixel centre in i64, and W at each centre by barycentric
-//! perspective interpolation of `1/W` in f64.
+//! The reference shares with the core only the rules: snapping for coverage (round to nearest, ties to even, 8 bits),
+//! the top-left rule and the W16 encoding `round(W / W_far * 65535)`. Its arithmetic is its own: coverage by
+//! evaluating the three edge functions of the snapped vertices at every pixel centre in i64, and W at each covered
+//! centre by barycentric interpolation of `1/W` over the vertices **as given** (f64, the true surface, extrapolated
+//! at a covered centre just outside the given triangle). It also reports how far the core's depth grid (vertices
+//! rounded to `2^-17` to `2^-29` px by the box's size, `wraster::depth_grid_bits`) may move the depth at each pixel,
+//! so that tests can add that derived term to their bounds.
 
 pub mod plot;
 
@@ -112,6 +115,39 @@ pub struct RefPixel {
     pub in_range: bool,
     /// `round(65535 / t)`, the W16 code (meaningful when in range).
     pub code: u16,
+    /// A bound, in W16 codes, on what rounding the vertices to the core's depth grid can change the code's exact
+    /// value `65535 / t` by at this pixel: the planes of `t` through the grid positions `q_k` and through the given
+    /// `v_k` differ by an affine function worth `grad t . (q_k - v_k)` at `q_k`, so by at most
+    /// `sum |lambda_k| |grad t . (q_k - v_k)|` at the pixel (`lambda_k` its barycentrics in the `q` triangle); times
+    /// `65535 / (t (t - delta))`. Zero when the vertices lie on the grid.
+    pub grid_lsb: f64,
+    /// The same bound in units of `t` (what it is before the conversion to codes), for other formats.
+    pub grid_t: f64,
+}
+
+/// Barycentrics of `(px, py)` in the triangle `g` (f64, any orientation), unnormalised (the three edge functions)
+/// with their sum, the doubled signed area; `None` for a degenerate triangle. (Dividing once keeps a constant plane
+/// exact: the edge functions of small grid positions are exact in f64.)
+fn barycentrics(g: &[(f64, f64); 3], px: f64, py: f64) -> Option<([f64; 3], f64)> {
+    let e = |a: (f64, f64), b: (f64, f64)| (b.0 - a.0) * (py - a.1) - (b.1 - a.1) * (px - a.0);
+    let area = (g[1].0 - g[0].0) * (g[2].1 - g[0].1) - (g[1].1 - g[0].1) * (g[2].0 - g[0].0);
+    if area == 0.0 {
+        return None;
+    }
+    Some(([e(g[1], g[2]), e(g[2], g[0]), e(g[0], g[1])], area))
+}
+
+/// The gradient of the plane through `(g_k, t_k)`.
+fn gradient(g: &[(f64, f64); 3], t: [f64; 3]) -> Option<(f64, f64)> {
+    let area = (g[1].0 - g[0].0) * (g[2].1 - g[0].1) - (g[1].1 - g[0].1) * (g[2].0 - g[0].0);
+    if area == 0.0 {
+        return None;
+    }
+    let tx =
+        -((g[2].1 - g[1].1) * t[0] + (g[0].1 - g[2].1) * t[1] + (g[1].1 - g[0].1) * t[2]) / area;
+    let ty =
+        ((g[2].0 - g[1].0) * t[0] + (g[0].0 - g[2].0) * t[1] + (g[1].0 - g[0].0) * t[2]) / area;
+    Some((tx, ty))
 }
 
 /// The reference's pixels of one triangle inside columns `[0, width)` and rows `rows`, in row-major order.
@@ -135,6 +171,28 @@ pub fn reference_tri(
     if area == 0 {
         return None;
     }
+    // Depth: the given positions (orientation does not matter to a plane), and the depth grid's positions.
+    let given = v.map(|(x, y, _)| (x as f64, y as f64));
+    let tk = v.map(|(_, _, rhw)| rhw as f64 * far as f64);
+    // The core's depth grid for this box (the shared rule: `wraster::depth_grid_bits` of the snapped box's larger
+    // side in whole pixels); rounding relative to the box's first pixel is rounding the coordinate itself.
+    let px_of = |c: f32| snap(c) >> 8;
+    let extent = |f: fn(&(f32, f32, f32)) -> f32| {
+        let c: Vec<i64> = v.iter().map(|q| px_of(f(q))).collect();
+        c.iter().max().unwrap() - c.iter().min().unwrap()
+    };
+    let bits = wraster::depth_grid_bits(extent(|q| q.0).max(extent(|q| q.1)) as i32);
+    let scale = (1u64 << bits) as f64;
+    let grid_of = |c: f64| (c * scale).round_ties_even() / scale;
+    let on_grid = given.map(|(x, y)| (grid_of(x), grid_of(y)));
+    let grad = gradient(&given, tk);
+    let shift = match grad {
+        Some((tx, ty)) => {
+            let d = |k: usize| tx * (on_grid[k].0 - given[k].0) + ty * (on_grid[k].1 - given[k].1);
+            [d(0), d(1), d(2)]
+        }
+        None => [0.0; 3],
+    };
     if area < 0 {
         p.swap(1, 2);
     }
@@ -163,15 +221,37 @@ pub fn reference_tri(
             if !inside {
                 continue;
             }
-            let t = (w[0] * p[0].2 + w[1] * p[1].2 + w[2] * p[2].2) / area;
+            let (cx, cy) = (i as f64 + 0.5, j as f64 + 0.5);
+            // The true surface through the given vertices; a degenerate given triangle (whose snapped one is not) has
+            // none, and takes the snapped vertices' plane, as the core does.
+            let (t, grid) = match barycentrics(&given, cx, cy) {
+                Some((e, a)) if grad.is_some() => {
+                    let (eq, aq) = barycentrics(&on_grid, cx, cy).unwrap_or((e, a));
+                    let g: f64 = (0..3).map(|k| (eq[k] / aq).abs() * shift[k].abs()).sum();
+                    ((e[0] * tk[0] + e[1] * tk[1] + e[2] * tk[2]) / a, g)
+                }
+                _ => ((w[0] * p[0].2 + w[1] * p[1].2 + w[2] * p[2].2) / area, 0.0),
+            };
             let in_range = t >= 1.0 && t * near as f64 <= far as f64;
             let code = (65535.0 / t).round().clamp(0.0, 65535.0) as u16;
+            // 65535 |1/t - 1/(t + delta)| <= 65535 delta / (t (t - delta)), with a relative 1e-9 for f64 rounding.
+            let grid_lsb = if grid == 0.0 {
+                0.0
+            } else {
+                65535.0 * grid * (1.0 + 1e-9) / (t * (t - grid)).abs() + 1e-12
+            };
             out.push(RefPixel {
                 x: i as i32,
                 y: j as i32,
                 t,
                 in_range,
                 code,
+                grid_lsb,
+                grid_t: if grid == 0.0 {
+                    0.0
+                } else {
+                    grid * (1.0 + 1e-9) + 1e-300
+                },
             });
         }
     }

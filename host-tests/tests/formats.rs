@@ -130,7 +130,13 @@ fn within_bound<F: Codec>() {
                 let want = exact_fraction::<F>(d, nd, fd);
                 let got = F::fraction(code, nd, fd);
                 let err = (got - want).abs();
-                let bound = value_bound::<F>(want) + half_step::<F>(code, nd, fd);
+                // Plus what the depth grid can move the exact value (`RefPixel::grid_t`, derived): the format's
+                // value at `t` moved by that much either way.
+                let gt = p.grid_t.min(p.t / 2.0);
+                let grid = (exact_fraction::<F>(fd / (p.t - gt), nd, fd) - want)
+                    .abs()
+                    .max((exact_fraction::<F>(fd / (p.t + gt), nd, fd) - want).abs());
+                let bound = value_bound::<F>(want) + half_step::<F>(code, nd, fd) + grid;
                 assert!(
                     err <= bound,
                     "{} n={n} f={f} d={d}: value {got} vs exact {want}, err {err:e} > bound {bound:e}",
@@ -144,8 +150,8 @@ fn within_bound<F: Codec>() {
                 if code != e {
                     let mid = (got + F::fraction(e, nd, fd)) / 2.0;
                     assert!(
-                        (want - mid).abs() <= value_bound::<F>(want),
-                        "{} n={n} f={f} d={d}: code {code}, correctly rounded {e}, exact {want} is {:e} from their midpoint (bound {:e})",
+                        (want - mid).abs() <= value_bound::<F>(want) + grid,
+                        "{} n={n} f={f} d={d}: code {code}, correctly rounded {e}, exact {want} is {:e} from their midpoint (bound {:e} + grid {grid:e})",
                         F::NAME,
                         (want - mid).abs(),
                         value_bound::<F>(want)

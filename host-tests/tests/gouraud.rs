@@ -109,11 +109,9 @@ fn gouraud_is_perspective_correct() {
 
 /// The exact perspective-correct colour at a pixel centre (f64, barycentric on the snapped vertices).
 fn reference_color(v: &[Vertex<Rgb888>; 3], i: i32, j: i32) -> [f64; 3] {
-    let p: Vec<(f64, f64)> = v
-        .iter()
-        .map(|q| (host_tests::snap(q.x) as f64, host_tests::snap(q.y) as f64))
-        .collect();
-    let (px, py) = (256.0 * i as f64 + 128.0, 256.0 * j as f64 + 128.0);
+    // The vertices as given: the colour planes, like the depth plane, go through them (not the snapped ones).
+    let p: Vec<(f64, f64)> = v.iter().map(|q| (q.x as f64, q.y as f64)).collect();
+    let (px, py) = (i as f64 + 0.5, j as f64 + 0.5);
     let e = |a: (f64, f64), b: (f64, f64)| (b.0 - a.0) * (py - a.1) - (b.1 - a.1) * (px - a.0);
     let w = [e(p[1], p[2]), e(p[2], p[0]), e(p[0], p[1])];
     let den: f64 = (0..3).map(|k| w[k] * v[k].rhw as f64).sum();

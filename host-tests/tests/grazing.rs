@@ -46,15 +46,17 @@ fn visible(state: RenderState) -> (usize, usize) {
     (s.fragments as usize, shown)
 }
 
-/// Coplanar at a grazing angle. Snapping moves each vertex by at most 1/512 px in x and y, so the `t` of each
-/// triangle's plane errs by at most `|grad t| sqrt(2) / 512` at its vertices and so everywhere inside; two triangles
-/// disagree by twice that, in codes `2 sqrt(2) / 512 |grad code| <= (4 / 512) g` with `g` the larger axis slope of the
-/// code at the pixel. The code `65535 / t` is not planar: along a segment from `t0` to `t1` its local slope is at most
-/// `t_max / t_min = r` times its secant slope, and the Windows CE "Depth Buffering" docs' `m` (the bias's slope) is that secant slope of B's vertex
-/// codes, so `g <= r m`. With the 3 codes of rounding (bias.rs), an offset of `-(3 + r m / 128)` codes is enough:
-/// `depth_bias = -4` and `slope_scale_depth_bias = -r / 128`. Without bias the pair fights.
+/// Coplanar at a grazing angle. The depth planes go through the vertices rounded to the depth grid (`2^-17` px or
+/// finer), so each triangle's `t` errs by at most `|grad t| 2^-18` at its vertices and everywhere inside (with the
+/// bounded extrapolation of `wraster::raster`'s `depth_plane` at covered pixels just outside); two triangles disagree
+/// by twice that, in codes `2^-17 |grad code| <= 2^-17 g` with `g` the larger axis slope of the code at the pixel. The
+/// code `65535 / t` is not planar: along a segment from `t0` to `t1` its local slope is at most `t_max / t_min = r`
+/// times its secant slope, and the Windows CE "Depth Buffering" docs' `m` (the bias's slope) is that secant slope of
+/// B's vertex codes, so `g <= r m`. With the 3 codes of rounding (bias.rs), an offset of `-(3 + r m 2^-17)` codes is
+/// enough: `depth_bias = -4` alone here (`r m 2^-17` is far below a code), and the slope term (`-r / 128`, what the
+/// snapped vertices' 1/512 px needed when the planes went through them) changes nothing. Without bias the pair fights.
 #[test]
-fn coplanar_pair_at_a_grazing_angle_needs_slope_scaled_bias() {
+fn coplanar_pair_at_a_grazing_angle_needs_bias() {
     let base = RenderState::new(1.0, FAR).unwrap();
     let (covered, shown) = visible(base);
     println!("grazing coplanar, no bias: B shows on {shown} of {covered}");
@@ -75,6 +77,17 @@ fn coplanar_pair_at_a_grazing_angle_needs_slope_scaled_bias() {
         "grazing coplanar, bias -4 and slope scale -{:.3} (r = {r:.1}): {shown} of {covered}",
         r / 128.0
     );
+    assert_eq!(shown, covered, "B must show on every pixel it covers");
+
+    // The depth planes go through the vertices as given (on the depth grid of `2^-17` px or finer), not the snapped
+    // ones: the two triangles' planes are the same plane up to that grid, so the constant offset alone is enough now.
+    let constant = RenderState {
+        depth_bias: -4.0,
+        slope_scale_depth_bias: 0.0,
+        ..base
+    };
+    let (covered, shown) = visible(constant);
+    println!("grazing coplanar, bias -4 alone: {shown} of {covered}");
     assert_eq!(shown, covered, "B must show on every pixel it covers");
 }
 
@@ -116,4 +129,92 @@ fn interpenetrating_surfaces_at_a_grazing_angle_resolve_outside_the_two_lsb_band
         decided > 3000 && blue > 500 && decided - blue > 500,
         "both surfaces show"
     );
+}
+
+/// Depth from the vertices as given, not as snapped, on grazing triangles: 4,000 random triangles (1 to 40 px, off
+/// the snap grid) lying on floors where W runs from `W_near` to `W_far` over 64 rows, each drawn alone, against the
+/// true surface through the given vertices (`reference_tri`). Derived bounds: every code within half a code plus the
+/// strategy's error (`2^-11.1` codes for the fast tier, `2^-12` for the exact tier) plus the depth grid's term
+/// (`RefPixel::grid_lsb`) of the exact value, so within 1 LSB while those stay under half a code; and off the
+/// correctly rounded code only within that sum of a rounding tie. The same triangles' planes through the *snapped*
+/// vertices (what the core used before) miss the true surface by many codes: counted and asserted, so this test
+/// tells the two apart.
+#[test]
+fn depth_comes_from_the_vertices_as_given_on_grazing_triangles() {
+    use host_tests::{reference_tri, snap, Rng};
+    use wraster::recip::{Exact, Fast, SpanRecip};
+    use wraster::Compare;
+    fn run<R: SpanRecip>(tie: f64) -> (u64, u64, u64, i64, f64) {
+        let mut rng = Rng(77);
+        let (near, far) = (1.0f32, FAR);
+        let mut state = RenderState::new(near, far).unwrap();
+        state.compare = Compare::Always;
+        let mut r = Rasterizer::<R>::new(state);
+        let mut depth = vec![0u16; W as usize * H as usize];
+        let (mut pixels, mut exact, mut snapped_over_1, mut snapped_worst, mut grid_max) =
+            (0u64, 0u64, 0u64, 0i64, 0f64);
+        for _ in 0..4000 {
+            // A floor: 1/W affine in y from 1/W_far at row 0 to about 1/W_near at row 64, with a random tilt.
+            let (a, b) = (rng.f(-0.002, 0.002), rng.f(0.9, 1.0));
+            let floor = move |x: f64, y: f64| {
+                (1.0 / far as f64 + (b - 1.0 / far as f64) * (y / 64.0) + a * (x / 96.0))
+                    .max(1.2 / far as f64)
+            };
+            let size = rng.log(1.0, 40.0);
+            let (cx, cy) = (rng.f(0.0, 96.0), rng.f(0.0, 64.0));
+            let tri = [0, 1, 2].map(|_| {
+                let (x, y) = (cx + rng.f(-size, size), cy + rng.f(-size, size));
+                Vertex::new(x as f32, y as f32, (1.0 / floor(x, y)) as f32, Rgb565::RED)
+            });
+            let mut frame = Frame::new(W as u32, H as u32);
+            let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
+            buf.clear();
+            r.draw(&mut frame, &mut buf, &tri).unwrap();
+            let v = tri.map(|q| (q.x, q.y, q.rhw));
+            let snapped = v.map(|(x, y, w)| (snap(x) as f32 / 256.0, snap(y) as f32 / 256.0, w));
+            let truth = reference_tri(&v, near, far, W as i32, 0..H as i32).unwrap_or_default();
+            let old = reference_tri(&snapped, near, far, W as i32, 0..H as i32).unwrap_or_default();
+            for p in truth.iter().filter(|p| p.in_range) {
+                let k = p.y as usize * W as usize + p.x as usize;
+                let e = 65535.0 / p.t;
+                let got = depth[k] as f64;
+                let g = p.grid_lsb;
+                grid_max = grid_max.max(g);
+                assert!(frame.writes[k] == 1, "covered pixel drawn");
+                assert!(
+                    (got - e).abs() <= 0.5 + tie + g + 1e-9
+                        && ((got - p.code as f64).abs() <= 1.0 || tie + g >= 0.5),
+                    "{}: code {got}, exact {e} (grid term {g}): {tri:?}",
+                    R::NAME
+                );
+                let from_tie = (e - e.floor() - 0.5).abs();
+                assert!(got == p.code as f64 || from_tie <= tie + g + 1e-9);
+                pixels += 1;
+                exact += u64::from(got == p.code as f64);
+                if let Some(o) = old.iter().find(|o| o.x == p.x && o.y == p.y && o.in_range) {
+                    let d = (o.code as i64 - p.code as i64).abs();
+                    snapped_over_1 += u64::from(d > 1);
+                    snapped_worst = snapped_worst.max(d);
+                }
+            }
+        }
+        (pixels, exact, snapped_over_1, snapped_worst, grid_max)
+    }
+    for (name, (pixels, exact, over, worst, grid_max)) in [
+        ("fast", run::<Fast>(2f64.powf(-11.1))),
+        ("exact", run::<Exact>(2f64.powi(-12))),
+    ] {
+        println!(
+            "grazing, depth from the given vertices, {name}: {pixels} px, {exact} exact ({:.4}%), largest grid term \
+             {grid_max:.2e} codes; the snapped vertices' planes: {over} px over 1 code off the true surface, up to {worst}",
+            100.0 * exact as f64 / pixels as f64
+        );
+        assert!(pixels > 100_000);
+        // At least 1 - 2 (2^-11.1 + largest grid term) exact: a code is off only within that of a tie.
+        assert!(exact as f64 >= pixels as f64 * (1.0 - 2.0 * (2f64.powf(-11.1) + grid_max)));
+        assert!(
+            over > 100 && worst > 4,
+            "the snapped planes miss the true surface"
+        );
+    }
 }
