@@ -25,9 +25,10 @@ pub trait VertexInput: sealed::Sealed + Copy {
     /// `x` and `y` on the 16.8 grid (round to nearest, ties to even), checked against [`GUARD_BAND`].
     #[doc(hidden)]
     fn snapped(&self) -> Result<(i32, i32), Error>;
-    /// Whether `x` and `y` lie on the 16.8 snap grid (then the snapped vertex is the vertex as given).
+    /// [`VertexInput::snapped`], and whether `x` and `y` lie on the 16.8 snap grid (then the snapped vertex is the
+    /// vertex as given).
     #[doc(hidden)]
-    fn on_snap_grid(&self) -> bool;
+    fn snapped_exact(&self) -> Result<(i32, i32, bool), Error>;
     /// `x - ox` and `y - oy` on the depth grid of `bits` fraction bits (round to nearest, ties to even; see
     /// `crate::raster::depth_grid_bits`): the positions the depth plane goes through. Only called after
     /// [`VertexInput::snapped`] accepted the vertex, with an origin and `bits` that keep the results below `2^31`.
@@ -41,14 +42,21 @@ pub trait VertexInput: sealed::Sealed + Copy {
     fn color(&self) -> Self::Color;
 }
 
+/// [`snap_exact`]'s value alone (the unit tests' name for it).
+#[cfg(test)]
+fn snap(v: f32) -> Result<i32, Error> {
+    snap_exact(v).map(|(r, _)| r)
+}
+
 // Out of line: one copy instead of one per coordinate (flash), for a few instructions per vertex.
 /// `round(v * 256)`, ties to even, for `|v| < GUARD_BAND = 2^12` (else `OutOfGuardBand`; NaN and infinities
 /// `NonFinite`), in 32-bit integer operations on the bits: `|v| < 2^12` means a biased exponent of at most 138, so
 /// `v * 256 = m 2^-s` with the 24-bit mantissa `m` and `s = 142 - exp >= 4`: a right shift with round-to-nearest-even
 /// of a 32-bit value (no 64-bit shift, which is a library call on the Cortex-M0). The same value as
 /// `fixed::to_fixed(v, 8, 12)` (tested on every bit pattern class in the unit tests).
+/// Also says whether the snap was exact (`v` on the 1/256 grid: no remainder), which costs one mask.
 #[inline(never)]
-fn snap(v: f32) -> Result<i32, Error> {
+fn snap_exact(v: f32) -> Result<(i32, bool), Error> {
     const _: () = assert!(GUARD_BAND == 1 << 12 && SUBPIXEL_BITS == 8);
     let bits = v.to_bits();
     let mag = bits & 0x7fff_ffff;
@@ -61,23 +69,27 @@ fn snap(v: f32) -> Result<i32, Error> {
     }
     let exp = mag >> 23;
     if exp == 0 {
-        return Ok(0); // zero or subnormal: far below half a sub-pixel
+        return Ok((0, mag == 0)); // zero or subnormal: far below half a sub-pixel
     }
     let m = (mag & 0x7f_ffff) | 0x80_0000;
     let s = 142 - exp; // >= 4
-    let r = if s >= 26 {
-        0 // m < 2^24 < 2^(s - 1): below half a unit
+    let (r, exact) = if s >= 26 {
+        (0, false) // m < 2^24 < 2^(s - 1): below half a unit
     } else {
         // Round half to even without branches: adding `half - 1` carries into the quotient exactly when the
         // remainder is above half, and the quotient's low bit makes a tie carry only from an odd quotient.
-        (m + (1 << (s - 1)) - 1 + ((m >> s) & 1)) >> s
-    } as i32;
-    Ok(if bits >> 31 != 0 { -r } else { r })
+        (
+            (m + (1 << (s - 1)) - 1 + ((m >> s) & 1)) >> s,
+            m & ((1 << s) - 1) == 0,
+        )
+    };
+    let r = r as i32;
+    Ok((if bits >> 31 != 0 { -r } else { r }, exact))
 }
 
-/// `round(v * 2^bits)`, ties to even, for a finite `|v| < GUARD_BAND` (checked by [`snap`] first) and `bits <= 31`:
+/// `round(v * 2^bits)`, ties to even, for a finite `|v| < GUARD_BAND` (checked by [`snap_exact`] first) and `bits <= 31`:
 /// `v * 2^bits = m 2^(exp - 150 + bits)` with the 24-bit mantissa `m`; a left shift (exact, below `2^43`) where that
-/// exponent is not negative, else a rounded right shift as in [`snap`].
+/// exponent is not negative, else a rounded right shift as in [`snap_exact`].
 #[inline(never)]
 fn depth_grid(v: f32, bits: u32) -> i64 {
     const _: () = assert!(GUARD_BAND == 1 << 12);
@@ -106,31 +118,17 @@ fn depth_grid(v: f32, bits: u32) -> i64 {
     }
 }
 
-/// Whether `v * 256` is an integer (finite `v`): no mantissa bit below the snap grid's step.
-#[inline(always)]
-fn on_grid(v: f32) -> bool {
-    let mag = v.to_bits() & 0x7fff_ffff;
-    let exp = mag >> 23;
-    let m = (mag & 0x7f_ffff) | 0x80_0000;
-    match 142u32.checked_sub(exp) {
-        _ if mag == 0 => true,
-        _ if exp == 0 => false, // a nonzero subnormal
-        None | Some(0) => true,
-        Some(s) if s >= 24 => false,
-        Some(s) => m & ((1 << s) - 1) == 0,
-    }
-}
-
 impl<C> sealed::Sealed for Vertex<C> {}
 impl<C: Copy> VertexInput for Vertex<C> {
     type Color = C;
     #[inline]
     fn snapped(&self) -> Result<(i32, i32), Error> {
-        Ok((snap(self.x)?, snap(self.y)?))
+        Ok((snap_exact(self.x)?.0, snap_exact(self.y)?.0))
     }
     #[inline]
-    fn on_snap_grid(&self) -> bool {
-        on_grid(self.x) && on_grid(self.y)
+    fn snapped_exact(&self) -> Result<(i32, i32, bool), Error> {
+        let ((x, ex), (y, ey)) = (snap_exact(self.x)?, snap_exact(self.y)?);
+        Ok((x, y, ex & ey))
     }
     #[inline]
     fn depth_xy(&self, bits: u32, ox: i32, oy: i32) -> (i32, i32) {
@@ -221,8 +219,8 @@ impl<C: Copy, R: Fixed<Bits = u32>> VertexInput for FixedVertex<C, R> {
         Ok((x, y))
     }
     #[inline]
-    fn on_snap_grid(&self) -> bool {
-        true
+    fn snapped_exact(&self) -> Result<(i32, i32, bool), Error> {
+        self.snapped().map(|(x, y)| (x, y, true))
     }
     #[inline]
     fn depth_xy(&self, bits: u32, ox: i32, oy: i32) -> (i32, i32) {
@@ -297,7 +295,7 @@ mod tests {
 
     /// The depth grid equals the general exact conversion at every width it takes (17 to 29 fraction bits) wherever
     /// `snap` accepts the value (every exponent, the grid's ties, random bits), a value on the 1/256 grid lands on
-    /// `snap << (bits - 8)`, and `on_grid` says exactly when the snap is exact.
+    /// `snap << (bits - 8)`, and `snap_exact` says exactly when the snap is exact.
     #[test]
     fn depth_grid_equals_the_exact_conversion() {
         let check = |v: f32| {
@@ -313,7 +311,7 @@ mod tests {
                 }
                 // v * 256 is exact in f64 (an f32 times a power of two).
                 let exact = v as f64 * 256.0 == sn as f64;
-                assert_eq!(on_grid(v), exact, "{v:e}");
+                assert_eq!(snap_exact(v).unwrap().1, exact, "{v:e}");
             }
         };
         for exp in 0..=255u32 {

@@ -65,7 +65,7 @@ pub enum Colors<'a, C> {
     /// One colour per triangle (at least as many as `indices`).
     PerFace(&'a [C]),
     /// One colour per vertex (at least as many as `positions`): interpolated by
-    /// [`Rasterizer::draw_mesh_frame_gouraud`] (feature `gouraud`); the flat draws take a triangle's first vertex's
+    /// `Rasterizer::draw_mesh_frame_gouraud` (feature `gouraud`); the flat draws take a triangle's first vertex's
     /// colour, as Direct3D's flat shading does.
     PerVertex(&'a [C]),
 }

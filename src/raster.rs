@@ -198,9 +198,9 @@ impl<R: WSpan> Rasterizer<R> {
         let mut tm = [(0u64, 0i32); N];
         for k in 0..N {
             let r = v[k].rhw_exact()?;
-            let (x, y) = v[k].snapped()?;
+            let (x, y, exact) = v[k].snapped_exact()?;
             p[k] = Sub { x, y };
-            on_grid &= v[k].on_snap_grid();
+            on_grid &= exact;
             tm[k] = t_of(r, (fm, fe))?;
         }
         let mut q = [Sub { x: 0, y: 0 }; N];
@@ -250,13 +250,13 @@ impl<R: WSpan> Rasterizer<R> {
         rows: (i32, u16),
         fast: bool,
     ) -> Result<Result<Walk, Stats>, Error> {
-        self.prepare_setup(self.setup(v)?, rows, fast)
+        self.prepare_setup(&self.setup(v)?, rows, fast)
     }
 
     /// [`Rasterizer::prepare`] from a snapped and checked triangle.
     pub(crate) fn prepare_setup(
         &self,
-        s: Setup,
+        s: &Setup,
         rows: (i32, u16),
         fast: bool,
     ) -> Result<Result<Walk, Stats>, Error> {
@@ -287,7 +287,7 @@ impl<R: WSpan> Rasterizer<R> {
         let ymin = p[0].y.min(p[1].y).min(p[2].y);
         let mut t_or = order.map(|k| s.t[k]);
         let mut frac = s.frac;
-        let area = area.unsigned_abs() as i128;
+        let area = area.unsigned_abs() as i64; // below 2^43
         let snapped_plane = (p, area, SUBPIXEL_BITS, (0, 0));
         // Small: every vertex within 127 px (minus a pixel for the origin's offset) of the box's origin pixel.
         let small = fast && {
@@ -421,7 +421,7 @@ impl<R: SpanRecip> Rasterizer<R> {
                 return Ok(stats);
             }
         }
-        let mut w = match self.prepare_setup(s, (depth.y0(), depth.height()), R::FAST_W16)? {
+        let mut w = match self.prepare_setup(&s, (depth.y0(), depth.height()), R::FAST_W16)? {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
         };
@@ -571,13 +571,13 @@ impl<R: SpanRecip> Rasterizer<R> {
 pub(crate) struct Geom {
     /// Snapped positions (coverage; and the bias's slope), and their doubled area (positive).
     pub(crate) p: [Sub; 3],
-    pub(crate) area: i128,
+    pub(crate) area: i64,
     /// The positions the planes go through, in units of `2^-dbits` px from the pixel `dorigin`, and their doubled
     /// signed area in those units
     /// (nonzero; negative when rounding flipped the triangle against `p`'s orientation): the depth grid's, or the
     /// snapped ones where the vertices lie on the snap grid or [`depth_plane`] refuses.
     pub(crate) dq: [Sub; 3],
-    pub(crate) darea: i128,
+    pub(crate) darea: i64,
     pub(crate) dbits: u32,
     /// The pixel `dq` is relative to.
     pub(crate) dorigin: (i32, i32),
@@ -604,7 +604,7 @@ fn depth_plane(
     t: &[i64; 3],
     bits: u32,
     (ox, oy): (i32, i32),
-) -> Result<i128, Option<u32>> {
+) -> Result<i64, Option<u32>> {
     let up = bits - SUBPIXEL_BITS;
     let [q0, q1, q2] = *q;
     let (e1x, e1y) = ((q1.x - q0.x) as i128, (q1.y - q0.y) as i128);
@@ -627,7 +627,7 @@ fn depth_plane(
         .unwrap_or(0) as i128;
     let (lhs, rhs) = ((gx.abs() + gy.abs()) * r, area.abs() << 61);
     if lhs <= rhs {
-        return Ok(area);
+        return Ok(area as i64); // below 2^63
     }
     // lhs < rhs 2^e; one more bit for the rounding of the shifted `T` (which moves `g` by at most `2^32`).
     Err(Some(rhs.leading_zeros() - lhs.leading_zeros() + 2))
@@ -637,81 +637,130 @@ fn depth_plane(
 /// plane through `(p_k, T_q(p_k))` (what the fast set-ups solve, from the snapped positions they already have) is the
 /// depth-grid plane itself (an affine function is fixed by three points).
 ///
-/// With `p_k = q_k + r_k` (`r_k` the snap's rounding against the depth grid, at most `2^(bits - 9)` units),
-/// `T_q(p_k) = t_k + c_k`, `c_k = sum over j != k of mu_jk (t_j - t_k)`, `mu_jk` the barycentric of `p_k` for `q_j`
-/// in the `q` triangle: the edge opposite `q_j` passes through `q_k`, so `mu_jk = (b - a) x r_k / A` (`a`, `b` that
-/// edge's ends, `A` the doubled area). The cross products are exact in `i64` (`|b - a| < 2^31`, `|r| < 2^21`); each
-/// term `E (t_j - t_k) / A` takes its three operands' top 32 bits (`2^-31` each) and one 32-bit reciprocal of `A`
-/// ([`fresh61`], `2^-27.6`): below `2^-26.5` of the term off. Accepted when the terms' magnitudes sum to at most
-/// `T_min / 2^9` for every `k` (a plane gentle over the snap's 1/512 px), so the corrected values err by below
-/// `T_min 2^-35`, far inside both fast set-ups' margins; `None` otherwise (the exact solve then runs). 32- and
-/// 64-bit arithmetic only (no 128-bit product: those are library calls on the 32-bit cores). Only for vertices off
-/// the snap grid.
+/// `T_q(p_k) = t_k + grad T_q . r_k` with `r_k = p_k - q_k` (the snap's rounding against the depth grid, below
+/// `2^(bits - 9) <= 2^21` units). The gradient's numerators `(gx, gy)` are exact (`i64 x i32` products from two
+/// 32-bit multiplies each, below `2^94`); each is divided by the doubled area with its top 32 bits (`2^-31`) and one
+/// 32-bit reciprocal of the area's top 32 bits ([`fresh61`]: `2^-27.6`, the area's truncation `2^-31`), kept to 32
+/// bits (`2^-28`): below `2^-26.5` relative; then times `r` exactly, truncated (one unit). Accepted when
+/// `|c_k|`'s bound is at most `T_min / 2^9` for every `k` (a plane gentle over the snap's 1/512 px), so the corrected
+/// values err by below `T_min 2^-35`, far inside both fast set-ups' margins; `None` otherwise (the exact solve then
+/// runs). 32- and 64-bit arithmetic only (no 128-bit product: those are library calls on the 32-bit cores). Only for
+/// vertices off the snap grid.
 pub(crate) fn t_at_snapped(s: &Setup) -> Option<[i64; 3]> {
     use crate::fast::{bits64, fresh61, mul_wide};
     let (p, q, t) = (s.p, s.q, s.t);
     let up = s.dbits - SUBPIXEL_BITS;
     let (ox, oy) = (s.dorigin.0 << SUBPIXEL_BITS, s.dorigin.1 << SUBPIXEL_BITS);
-    // Edges opposite each vertex (q_(j+1) -> q_(j+2)) and the snap's rounding r_k: the snapped position relative to
-    // the box origin, on the grid, is below 2^31 (the grid's choice), and r_k below 2^21, so i32 throughout and
-    // every cross product one 32 x 32 -> 64 multiply.
-    let edge = |a: Sub, b: Sub| (b.x.wrapping_sub(a.x), b.y.wrapping_sub(a.y));
-    let ed = [edge(q[1], q[2]), edge(q[2], q[0]), edge(q[0], q[1])];
-    let r = [0, 1, 2].map(|k| {
-        (
-            ((p[k].x - ox) << up).wrapping_sub(q[k].x),
-            ((p[k].y - oy) << up).wrapping_sub(q[k].y),
-        )
-    });
-    let cross = |e: (i32, i32), v: (i32, i32)| e.0 as i64 * v.1 as i64 - e.1 as i64 * v.0 as i64;
-    let area = cross(ed[2], (q[2].x - q[0].x, q[2].y - q[0].y)); // (q1 - q0) x (q2 - q0), below 2^63
+    // `a b` exactly for `|a| < 2^63`, `|b| < 2^31`, as (sign, magnitude): two 32 x 32 -> 64 products.
+    #[inline(always)]
+    fn mul_wide_signed(a: i64, b: i32) -> (bool, u128) {
+        let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
+        let m = ((mul_wide((ua >> 32) as u32, ub) as u128) << 32) + mul_wide(ua as u32, ub) as u128;
+        ((a < 0) != (b < 0), m)
+    }
+    // `x - y` of two (sign, magnitude) pairs, as (sign, magnitude).
+    #[inline(always)]
+    fn sub((sx, x): (bool, u128), (sy, y): (bool, u128)) -> (bool, u128) {
+        if sx != sy {
+            (sx, x + y)
+        } else if x >= y {
+            (sx, x - y)
+        } else {
+            (!sx, y - x)
+        }
+    }
+    // `v` (nonzero, below 2^96) normalised to [2^31, 2^32) and the shift back: `v` is about `top 2^sh`, truncated by
+    // below `2^-31`.
+    #[inline(always)]
+    fn top(v: u128) -> (u32, i32) {
+        // Constant shifts of the u128 only (a variable one is a library call on the 32-bit cores): below 2^96, so
+        // `v >> 32` fits a u64 whenever `v` does not, and its truncation is inside the 2^-31 kept.
+        let (w, extra) = if (v >> 64) as u64 != 0 {
+            ((v >> 32) as u64, 32)
+        } else {
+            (v as u64, 0)
+        };
+        let b = bits64(w) as i32;
+        let n = if b <= 32 {
+            w << (32 - b)
+        } else {
+            w >> (b - 32)
+        };
+        (n as u32, b - 32 + extra)
+    }
+    let [q0, q1, q2] = q;
+    let (e1x, e1y) = (q1.x.wrapping_sub(q0.x), q1.y.wrapping_sub(q0.y));
+    let (e2x, e2y) = (q2.x.wrapping_sub(q0.x), q2.y.wrapping_sub(q0.y));
+    // Differences below 2^31: each product below 2^62, the doubled area below 2^63 (products by `mul_wide`: the
+    // M0's four `MULS` rather than an `__aeabi_lmul` call).
+    let smul = |a: i32, b: i32| {
+        let m = mul_wide(a.unsigned_abs(), b.unsigned_abs()) as i64;
+        if (a < 0) != (b < 0) {
+            -m
+        } else {
+            m
+        }
+    };
+    let area = smul(e1x, e2y) - smul(e2x, e1y);
     if area == 0 {
         return None;
     }
     let a = area.unsigned_abs();
     let la = 64 - bits64(a);
-    let m = ((a << la) >> 32) as u32; // in [2^31, 2^32)
-    let x = fresh61(m); // about 2^61 / m
-                        // v (nonzero) normalised to [2^31, 2^32) and the shift back: v is about top 2^sh, truncated by below 2^-31.
-    let top = |v: u64| {
-        let b = bits64(v) as i32;
-        let n = if b <= 32 {
-            v << (32 - b)
+    let m = ((a << la) >> 32) as u32; // in [2^31, 2^32): a = m 2^(32 - la), truncated
+    let x = fresh61(m) as u32; // about 2^61 / m
+                               // The gradient's numerators `g = (d1 e2y - d2 e1y, d2 e1x - d1 e2x)`, exact (below 2^94), each divided by the
+                               // area as `gh x 2^(sg + la - 93)` (`gh x` below 2^62), kept as its top 32 bits `G` and exponent `sg + la - 61`.
+    let (d1, d2) = (t[1] - t[0], t[2] - t[0]);
+    let grad = |g: (bool, u128)| -> (bool, u32, i32) {
+        if g.1 == 0 {
+            return (false, 0, 0);
+        }
+        let (gh, sg) = top(g.1);
+        (
+            g.0 != (area < 0),
+            (mul_wide(gh, x) >> 32) as u32,
+            sg + la as i32 - 61,
+        )
+    };
+    let gx = grad(sub(mul_wide_signed(d1, e2y), mul_wide_signed(d2, e1y)));
+    let gy = grad(sub(mul_wide_signed(d2, e1x), mul_wide_signed(d1, e2x)));
+    // `c_k = grad . r_k` (`r_k` the snap's rounding against the grid, below 2^21): each term `G |r| 2^e`, `G |r|`
+    // below 2^53, with its truncation (`+ 1`) in the bound.
+    let term = |(neg, gm, e): (bool, u32, i32), r: i32| -> Option<(i64, u64)> {
+        if gm == 0 || r == 0 {
+            return Some((0, 0));
+        }
+        let v = mul_wide(gm, r.unsigned_abs());
+        let v = if e >= 0 {
+            if e >= 10 || v >> (62 - e) != 0 {
+                return None; // a term of 2^62 or more
+            }
+            v << e
         } else {
-            v >> (b - 32)
+            v >> ((-e) as u32).min(63)
         };
-        (n as u32, b - 32)
+        Some((
+            if neg != (r < 0) {
+                -(v as i64)
+            } else {
+                v as i64
+            },
+            v + 1,
+        ))
     };
     let t_min = t[0].min(t[1]).min(t[2]);
     let lim = (t_min >> 9) as u64;
     let mut out = t;
     for k in 0..3 {
-        let (mut c, mut sum) = (0i64, 0u64);
-        for (j, &ej) in ed.iter().enumerate() {
-            let dt = t[j] - t[k];
-            let e = cross(ej, r[k]); // zero for j == k only by accident: its dt is zero
-            if e == 0 || dt == 0 {
-                continue;
-            }
-            // |e dt / A| = eh dh 2^(se + sd) / (m 2^(32 - la)) = (eh dh >> 32) x 2^(se + sd + la - 61).
-            let ((eh, se), (dh, sd)) = (top(e.unsigned_abs()), top(dt.unsigned_abs()));
-            let prod = (mul_wide(eh, dh) >> 32) as u32;
-            let sh = se + sd + la as i32 - 61;
-            if sh > 0 {
-                return None; // a term of 2^61 or more
-            }
-            let v = mul_wide(prod, x as u32) >> ((-sh) as u32).min(63);
-            sum += v + 1;
-            c += if (e < 0) ^ (dt < 0) ^ (area < 0) {
-                -(v as i64)
-            } else {
-                v as i64
-            };
-        }
-        if sum > lim {
+        let rx = ((p[k].x - ox) << up).wrapping_sub(q[k].x);
+        let ry = ((p[k].y - oy) << up).wrapping_sub(q[k].y);
+        let (cx, bx) = term(gx, rx)?;
+        let (cy, by) = term(gy, ry)?;
+        if bx + by > lim {
             return None;
         }
-        out[k] = t[k] + c;
+        out[k] = t[k] + cx + cy;
         if out[k] >= 1 << 61 || out[k] <= 0 {
             return None;
         }
@@ -741,7 +790,7 @@ impl Plane {
         let (d1, d2) = (v[1] as i128 - v[0] as i128, v[2] as i128 - v[0] as i128);
         let mut gx = d1 * (p2.y - p0.y) as i128 - d2 * (p1.y - p0.y) as i128;
         let mut gy = d2 * (p1.x - p0.x) as i128 - d1 * (p2.x - p0.x) as i128;
-        let mut area = g.darea;
+        let mut area = g.darea as i128;
         if area < 0 {
             (gx, gy, area) = (-gx, -gy, -area);
         }

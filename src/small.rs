@@ -253,12 +253,19 @@ fn emit<D: DrawTarget>(
     pass: u32,
     color: D::Color,
 ) -> Result<u32, Error> {
-    let fill = |target: &mut D, a: u32, len: u32| {
-        let r = Rectangle::new(Point::new(x0 + a as i32, j), Size::new(len, 1));
-        target.fill_solid(&r, color).map_err(|_| Error::Target)
-    };
+    #[inline(always)]
+    fn fill_run<D: DrawTarget>(
+        t: &mut D,
+        x: i32,
+        j: i32,
+        len: u32,
+        c: D::Color,
+    ) -> Result<(), Error> {
+        let r = Rectangle::new(Point::new(x, j), Size::new(len, 1));
+        t.fill_solid(&r, c).map_err(|_| Error::Target)
+    }
     if pass == u32::MAX >> (32 - n) {
-        fill(target, 0, n)?;
+        fill_run(target, x0, j, n, color)?;
         return Ok(n);
     }
     // Runs of set bits from the first pixel (bit n - 1) on: shifted to the top of a u64, whose leading zeros and
@@ -268,7 +275,7 @@ fn emit<D: DrawTarget>(
         let skip = m.leading_zeros();
         m <<= skip;
         let len = (!m).leading_zeros();
-        fill(target, at + skip, len)?;
+        fill_run(target, x0 + (at + skip) as i32, j, len, color)?;
         m = m.checked_shl(len).unwrap_or(0);
         at += skip + len;
     }
