@@ -598,6 +598,7 @@ pub(crate) struct Geom {
 /// right by `e` bits (`F - e` fraction bits, the plane's rounding then `2^e` times coarser) it is accepted; `Err(None)`
 /// for a degenerate `q`. Ranges: positions below `2^31` units (the
 /// grid's choice), so differences below `2^31`, `|g| < 2^93`, `r <= 2^(bits - 9) < 2^21`, `|area| < 2^63`.
+#[inline(never)] // once per triangle: out of line, one copy (flash)
 fn depth_plane(
     p: &[Sub; 3],
     q: &[Sub; 3],
@@ -646,6 +647,7 @@ fn depth_plane(
 /// values err by below `T_min 2^-35`, far inside both fast set-ups' margins; `None` otherwise (the exact solve then
 /// runs). 32- and 64-bit arithmetic only (no 128-bit product: those are library calls on the 32-bit cores). Only for
 /// vertices off the snap grid.
+#[inline(never)] // once per triangle: out of line, one copy (flash)
 pub(crate) fn t_at_snapped(s: &Setup) -> Option<[i64; 3]> {
     use crate::fast::{bits64, fresh61, mul_wide};
     let (p, q, t) = (s.p, s.q, s.t);
