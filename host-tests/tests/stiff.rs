@@ -332,3 +332,50 @@ fn denormals_nan_and_infinities_in_every_field() {
         Some(Error::InvalidDepthRange)
     );
 }
+
+/// Degenerate as given, not as snapped: three exactly collinear vertices on the 2^-10 px grid (so on every depth
+/// grid too), the two ends at pixel centres and the middle one off the snap grid, so the snapped triangle is a sliver
+/// whose long edge runs through pixel centres. The given triangle has no surface, so depth takes the snapped
+/// vertices' plane (`depth_plane`'s fallback; the reference does the same for a degenerate given triangle), and
+/// coverage is the snapped sliver's: every strategy within its bound of that, on every covered pixel.
+#[test]
+fn degenerate_as_given_but_not_as_snapped_takes_the_snapped_plane() {
+    let mut rng = Rng(21);
+    let (mut tris, mut pixels) = (0, 0);
+    while tris < 400 {
+        let g = |rng: &mut Rng, lo: i64, hi: i64| lo + (rng.bits() % (hi - lo) as u64) as i64;
+        let (i0, j0) = (g(&mut rng, 2, 40), g(&mut rng, 2, 30));
+        let (a, b) = (g(&mut rng, 1, 4), g(&mut rng, -3, 4));
+        let n = g(&mut rng, 4, 16);
+        let m = 4 * g(&mut rng, 1, n * 256 - 1) + g(&mut rng, 1, 4); // 1/1024 steps, off the 1/256 grid
+        let p0 = ((i0 * 1024 + 512), (j0 * 1024 + 512));
+        let p = [
+            p0,
+            (p0.0 + a * m, p0.1 + b * m),
+            (p0.0 + a * n * 1024, p0.1 + b * n * 1024),
+        ];
+        let s = p.map(|(x, y)| {
+            (
+                host_tests::snap(x as f32 / 1024.0),
+                host_tests::snap(y as f32 / 1024.0),
+            )
+        });
+        let area = (s[1].0 - s[0].0) * (s[2].1 - s[0].1) - (s[2].0 - s[0].0) * (s[1].1 - s[0].1);
+        if area == 0 {
+            continue;
+        }
+        let w = [
+            rng.log(1.0, 900.0),
+            rng.log(1.0, 900.0),
+            rng.log(1.0, 900.0),
+        ];
+        let mut tri = [0, 1, 2].map(|k| vtx(p[k].0 as f64 / 1024.0, p[k].1 as f64 / 1024.0, w[k]));
+        if rng.bits() % 2 == 0 {
+            tri.swap(1, 2);
+        }
+        pixels += both(tri, 1.0, 1000.0, 96, 64).pixels;
+        tris += 1;
+    }
+    println!("degenerate as given: {tris} triangles, {pixels} pixels");
+    assert!(pixels > 100, "the slivers cover pixels");
+}
