@@ -370,7 +370,7 @@ fn degenerate_as_given_but_not_as_snapped_takes_the_snapped_plane() {
             rng.log(1.0, 900.0),
         ];
         let mut tri = [0, 1, 2].map(|k| vtx(p[k].0 as f64 / 1024.0, p[k].1 as f64 / 1024.0, w[k]));
-        if rng.bits() % 2 == 0 {
+        if rng.bits().is_multiple_of(2) {
             tri.swap(1, 2);
         }
         pixels += both(tri, 1.0, 1000.0, 96, 64).pixels;
