@@ -336,21 +336,23 @@ fn walk<const UP: bool, D: DrawTarget>(
     Ok(())
 }
 
+/// Cores without a count-leading-zeros instruction, where `leading_zeros` is a library call: ARMv6-M (Cortex-M0,
+/// which has no 32-bit atomics either) and RV32IMAC (no Zbb).
+const NO_CLZ: bool = cfg!(any(
+    all(target_arch = "arm", not(target_has_atomic = "32")),
+    target_arch = "riscv32"
+));
+
 /// The leading zeros of `h` in `[2^18, 2^32)`: `CLZ` where the core has it; on the Cortex-M0 and RV32IMAC (no
 /// count-leading-zeros instruction; there `leading_zeros` is a library call of about 27 instructions) [`lz_search`].
 #[inline(always)]
 pub(crate) fn lz_small(h: u32) -> u32 {
     debug_assert!(h >= 1 << 18);
-    #[cfg(any(
-        all(target_arch = "arm", not(target_has_atomic = "32")),
-        target_arch = "riscv32"
-    ))]
-    return lz_search(h);
-    #[cfg(not(any(
-        all(target_arch = "arm", not(target_has_atomic = "32")),
-        target_arch = "riscv32"
-    )))]
-    return h.leading_zeros();
+    if NO_CLZ {
+        lz_search(h)
+    } else {
+        h.leading_zeros()
+    }
 }
 
 /// The bits of `v` (`64 - leading_zeros`, 0 for 0), for set-up code. ARMv6-M (Cortex-M0) and RV32IMAC have no
@@ -358,25 +360,13 @@ pub(crate) fn lz_small(h: u32) -> u32 {
 /// them for a `u64`), so they take a six-step binary search inline (tested against `leading_zeros`).
 #[inline(always)]
 pub(crate) fn bits64(v: u64) -> u32 {
-    #[cfg(any(
-        all(target_arch = "arm", not(target_has_atomic = "32")),
-        target_arch = "riscv32"
-    ))]
-    return bits_search(v);
-    #[cfg(not(any(
-        all(target_arch = "arm", not(target_has_atomic = "32")),
-        target_arch = "riscv32"
-    )))]
-    return 64 - v.leading_zeros();
+    if NO_CLZ {
+        bits_search(v)
+    } else {
+        64 - v.leading_zeros()
+    }
 }
 
-#[cfg_attr(
-    not(any(
-        all(target_arch = "arm", not(target_has_atomic = "32")),
-        target_arch = "riscv32"
-    )),
-    allow(dead_code)
-)]
 #[inline(always)]
 fn bits_search(v: u64) -> u32 {
     let (mut x, mut n) = if v >> 32 != 0 {
@@ -412,13 +402,6 @@ pub(crate) fn mul_wide(a: u32, b: u32) -> u64 {
 
 /// The leading zeros of `h >= 2^18` (so in `[0, 13]`) by four compares of a binary search (tested against
 /// `leading_zeros` on every host).
-#[cfg_attr(
-    not(any(
-        all(target_arch = "arm", not(target_has_atomic = "32")),
-        target_arch = "riscv32"
-    )),
-    allow(dead_code)
-)]
 #[inline(always)]
 fn lz_search(h: u32) -> u32 {
     let (mut h, mut n) = (h, 0);

@@ -248,6 +248,28 @@ impl<C: Copy, R: Fixed<Bits = u32>> VertexInput for FixedVertex<C, R> {
 mod tests {
     use super::*;
 
+    /// Every exponent with mantissas at both ends, the middle and one off each, both signs; then `random` xorshift32
+    /// bit patterns from `seed`, each also masked to mostly fall inside the guard band.
+    fn each_bit_class(random: usize, seed: u32, mut check: impl FnMut(f32)) {
+        for exp in 0..=255u32 {
+            for frac in [
+                0, 1, 2, 3, 0x40_0000, 0x40_0001, 0x3f_ffff, 0x7f_ffff, 0x7f_fffe, 0x7f_ff00,
+            ] {
+                for sign in [0, 1u32 << 31] {
+                    check(f32::from_bits(sign | exp << 23 | frac));
+                }
+            }
+        }
+        let mut s = seed;
+        for _ in 0..random {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            check(f32::from_bits(s));
+            check(f32::from_bits(s & 0x45ff_ffff));
+        }
+    }
+
     /// The 32-bit snap equals the general exact conversion (`to_fixed`, 64-bit) on every exponent, on ties (half a
     /// sub-pixel, odd and even), at the guard band, on subnormals, zeros, NaN and infinities, and on random bits.
     #[test]
@@ -258,15 +280,7 @@ mod tests {
             Err(true) => Err(Error::OutOfGuardBand),
         };
         let check = |v: f32| assert_eq!(snap(v), reference(v), "{v:e} ({:#x})", v.to_bits());
-        for exp in 0..=255u32 {
-            for frac in [
-                0, 1, 2, 3, 0x40_0000, 0x40_0001, 0x3f_ffff, 0x7f_ffff, 0x7f_fffe,
-            ] {
-                for sign in [0, 1u32 << 31] {
-                    check(f32::from_bits(sign | exp << 23 | frac));
-                }
-            }
-        }
+        each_bit_class(1_000_000, 0x9E37_79B9, check);
         for k in -8192i32..=8192 {
             // every half sub-pixel: the ties
             check(k as f32 / 512.0);
@@ -282,14 +296,6 @@ mod tests {
             f32::NEG_INFINITY,
         ] {
             check(v);
-        }
-        let mut s = 0x9E37_79B9u32;
-        for _ in 0..1_000_000 {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            check(f32::from_bits(s));
-            check(f32::from_bits(s & 0x45ff_ffff)); // mostly inside the guard band
         }
     }
 
@@ -314,27 +320,11 @@ mod tests {
                 assert_eq!(snap_exact(v).unwrap().1, exact, "{v:e}");
             }
         };
-        for exp in 0..=255u32 {
-            for frac in [
-                0, 1, 2, 3, 0x40_0000, 0x40_0001, 0x3f_ffff, 0x7f_ffff, 0x7f_fffe, 0x7f_ff00,
-            ] {
-                for sign in [0, 1u32 << 31] {
-                    check(f32::from_bits(sign | exp << 23 | frac));
-                }
-            }
-        }
+        each_bit_class(200_000, 0x2545_F491, check);
         for k in -(1i32 << 16)..(1 << 16) {
             check(k as f32 / (1 << 19) as f32); // ties of the 18-bit grid near 0
             check(k as f32 / (1 << 24) as f32 + 0.25); // and of finer grids
             check(k as f32 / 256.0); // the snap grid
-        }
-        let mut s = 0x2545_F491u32;
-        for _ in 0..200_000 {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            check(f32::from_bits(s));
-            check(f32::from_bits(s & 0x45ff_ffff));
         }
     }
 }

@@ -573,9 +573,9 @@ pub(crate) struct Geom {
     pub(crate) p: [Sub; 3],
     pub(crate) area: i64,
     /// The positions the planes go through, in units of `2^-dbits` px from the pixel `dorigin`, and their doubled
-    /// signed area in those units
-    /// (nonzero; negative when rounding flipped the triangle against `p`'s orientation): the depth grid's, or the
-    /// snapped ones where the vertices lie on the snap grid or [`depth_plane`] refuses.
+    /// signed area in those units (nonzero; negative when rounding flipped the triangle against `p`'s orientation):
+    /// the depth grid's, or the snapped ones where the vertices lie on the snap grid, where the fast tier solves
+    /// through them with [`t_at_snapped`]'s values, or where [`depth_plane`] refuses.
     pub(crate) dq: [Sub; 3],
     pub(crate) darea: i64,
     pub(crate) dbits: u32,
@@ -586,8 +586,20 @@ pub(crate) struct Geom {
     pub(crate) j0: i32,
 }
 
+/// The snap's rounding against the depth grid at one vertex, `r = p - q` in units of the grid (`bits` fraction bits,
+/// relative to the pixel `origin`): the snapped position there is below `2^31` units (the grid's choice), and
+/// `|r|` at most `2^(bits - 9)` (half a sub-pixel plus half a grid step), so `i32` throughout.
+#[inline(always)]
+fn snap_rounding(p: Sub, q: Sub, bits: u32, (ox, oy): (i32, i32)) -> (i32, i32) {
+    let up = bits - SUBPIXEL_BITS;
+    (
+        ((p.x - (ox << SUBPIXEL_BITS)) << up).wrapping_sub(q.x),
+        ((p.y - (oy << SUBPIXEL_BITS)) << up).wrapping_sub(q.y),
+    )
+}
+
 /// The doubled signed area of the depth-grid triangle `q` (oriented like `p`), if the plane of `t` through it can be
-/// walked: `None` when `q` is degenerate, or when a covered pixel could take a `T` beyond `2^62` in magnitude.
+/// walked (`Err` otherwise: see below).
 ///
 /// A covered pixel lies in the snapped triangle `p`, so it is a convex combination of the `p_k = q_k - r_k` (`r_k`
 /// the rounding of the snap against the depth grid): `P = Q - R` with `Q` in `q`'s triangle and each coordinate of
@@ -596,8 +608,8 @@ pub(crate) struct Geom {
 /// pixel's `T` then lies in `(-2^61, 2^62)` and its walked value is exact modulo `2^64` (module doc); the range test
 /// rejects the extrapolated pixels whose `T` leaves `[2^F, T_near]`. Otherwise `Err(Some(e))`: with `T` shifted
 /// right by `e` bits (`F - e` fraction bits, the plane's rounding then `2^e` times coarser) it is accepted; `Err(None)`
-/// for a degenerate `q`. Ranges: positions below `2^31` units (the
-/// grid's choice), so differences below `2^31`, `|g| < 2^93`, `r <= 2^(bits - 9) < 2^21`, `|area| < 2^63`.
+/// for a degenerate `q`. Ranges: positions below `2^31` units (the grid's choice), so differences below `2^31`,
+/// `|g| < 2^93`, `r <= 2^(bits - 9) < 2^21`, `|area| < 2^63`.
 #[inline(never)] // once per triangle: out of line, one copy (flash)
 fn depth_plane(
     p: &[Sub; 3],
@@ -606,7 +618,6 @@ fn depth_plane(
     bits: u32,
     (ox, oy): (i32, i32),
 ) -> Result<i64, Option<u32>> {
-    let up = bits - SUBPIXEL_BITS;
     let [q0, q1, q2] = *q;
     let (e1x, e1y) = ((q1.x - q0.x) as i128, (q1.y - q0.y) as i128);
     let (e2x, e2y) = ((q2.x - q0.x) as i128, (q2.y - q0.y) as i128);
@@ -619,10 +630,8 @@ fn depth_plane(
     let gy = d2 * e1x - d1 * e2x;
     let r = (0..3)
         .map(|k| {
-            let rx = q[k].x as i64 - ((p[k].x as i64 - ((ox as i64) << SUBPIXEL_BITS)) << up);
-            let ry = q[k].y as i64 - ((p[k].y as i64 - ((oy as i64) << SUBPIXEL_BITS)) << up);
-            let (rx, ry) = (rx.unsigned_abs(), ry.unsigned_abs());
-            rx.max(ry)
+            let (rx, ry) = snap_rounding(p[k], q[k], bits, (ox, oy));
+            rx.unsigned_abs().max(ry.unsigned_abs())
         })
         .max()
         .unwrap_or(0) as i128;
@@ -651,8 +660,6 @@ fn depth_plane(
 pub(crate) fn t_at_snapped(s: &Setup) -> Option<[i64; 3]> {
     use crate::fast::{bits64, fresh61, mul_wide};
     let (p, q, t) = (s.p, s.q, s.t);
-    let up = s.dbits - SUBPIXEL_BITS;
-    let (ox, oy) = (s.dorigin.0 << SUBPIXEL_BITS, s.dorigin.1 << SUBPIXEL_BITS);
     // `a b` exactly for `|a| < 2^63`, `|b| < 2^31`, as (sign, magnitude): two 32 x 32 -> 64 products.
     #[inline(always)]
     fn mul_wide_signed(a: i64, b: i32) -> (bool, u128) {
@@ -755,8 +762,7 @@ pub(crate) fn t_at_snapped(s: &Setup) -> Option<[i64; 3]> {
     let lim = (t_min >> 9) as u64;
     let mut out = t;
     for k in 0..3 {
-        let rx = ((p[k].x - ox) << up).wrapping_sub(q[k].x);
-        let ry = ((p[k].y - oy) << up).wrapping_sub(q[k].y);
+        let (rx, ry) = snap_rounding(p[k], q[k], s.dbits, s.dorigin);
         let (cx, bx) = term(gx, rx)?;
         let (cy, by) = term(gy, ry)?;
         if bx + by > lim {

@@ -51,7 +51,7 @@ use embedded_graphics_core::primitives::Rectangle;
 use crate::depth::DepthBuffer;
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
-use crate::fast::{fresh61, lz_small, mul_hi, mul_wide, MIN_SPAN};
+use crate::fast::{bits64 as bits, fresh61, lz_small, mul_hi, mul_wide, MIN_SPAN};
 use crate::raster::{rows_of, Setup, Stats, SUBPIXEL_BITS};
 use crate::state::{Cull, RenderState};
 use crate::Error;
@@ -62,8 +62,6 @@ use crate::Error;
 fn margin(t_max: u64) -> u64 {
     (t_max >> 32) + (1 << 17)
 }
-
-use crate::fast::bits64 as bits;
 
 /// Draws the snapped triangle `s` in `color` if it is a small triangle this path takes (see the module doc), with
 /// `Less`, depth write and no bias (the caller's conditions). `Ok(None)`, having written nothing, where it does not
