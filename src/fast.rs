@@ -86,11 +86,13 @@ impl Bin {
     fn code(&self, x: i32) -> u16 {
         ((x as u32).wrapping_add(self.round) >> self.s) as u16
     }
-    /// Whether the stored code `stored` rules out any computed code below it (`Less` fails for sure).
-    #[inline(always)]
-    fn fails(&self, tau: u32, stored: u16) -> bool {
-        (tau >> 17) * stored as u32 <= self.lim
-    }
+}
+
+/// Whether the stored code `stored` rules out any computed code below it (`Less` fails for sure), with the binade's
+/// prefilter limit `lim` ([`Bin`]).
+#[inline(always)]
+fn ruled_out(tau: u32, stored: u16, lim: u32) -> bool {
+    (tau >> 17) * stored as u32 <= lim
 }
 
 /// Cells of the fresh seed: 128 over `d = m / 2^32` in `[1/2, 1)`.
@@ -116,23 +118,61 @@ const fn seed_table() -> [(u32, u32); CELLS] {
     t
 }
 
-/// `2^61 / m` for `m` in `[2^31, 2^32)`: the table's chord at 9 bits of the position in the cell (one 32-bit
-/// multiply: the drop is below `2^23`), then one Newton-Raphson step. Seed error: the chord `2^-17.9`, the
-/// position truncated to 9 bits (`drop / 2^9 < 2^23 / 2^9` units, `2^-15` relative to `x > 2^29`), the entries' rounding:
-/// below `2^-14.8`; after the step `(2^-14.8)^2 + 2^-28 < 2^-27.6`.
+/// How the fresh reciprocal `2^61 / m` (`m` in `[2^31, 2^32)`) is seeded before its one Newton-Raphson step: a type,
+/// so that each strategy's loops are compiled with one seed and link no other. Both seeds err by less than `2^-14.8`,
+/// so both give `(2^-14.8)^2 + 2^-28 < 2^-27.6` after the step (`newton`: the squared seed error plus the products'
+/// truncation), and the fast tier's bound [`FAST_MAX_REL_ERROR`] holds for either. They differ in the last bits of
+/// `x`, so a strategy's frames are the same on every core only with the same seed: each seed is its own strategy
+/// ([`crate::recip::Fast`], [`crate::recip::FastDiv`]).
+pub(crate) trait FreshSeed {
+    /// The seed, in units of `2^-29` (`x` near `2^61 / m`, in `(2^29, 2^30]`).
+    fn seed61(m: u32) -> i32;
+}
+
+/// The table seed: a 128-cell chord of `1/d` at 9 bits of the position in the cell (one 32-bit multiply: the drop is
+/// below `2^23`). Error: the chord `2^-17.9`, the position truncated to 9 bits (`drop / 2^9 < 2^23 / 2^9` units,
+/// `2^-15` relative to `x > 2^29`), the entries' rounding: below `2^-14.8`. No division: the seed for cores without
+/// a divide instruction (the Cortex-M0).
+pub(crate) struct Chord;
+
+impl FreshSeed for Chord {
+    #[inline(always)]
+    fn seed61(m: u32) -> i32 {
+        const T: [(u32, u32); CELLS] = seed_table();
+        let (y, drop) = T[((m >> 24) & 127) as usize];
+        let u = (m >> 15) & 511;
+        (y - ((drop * u) >> 9)) as i32
+    }
+}
+
+/// The division seed: `2^13 floor((2^32 - 1) / d)` with `d = floor(m / 2^16)` (in `[2^15, 2^16)`), one `UDIV` on
+/// the Cortex-M3/M4 and RV32IM (a library call on the Cortex-M0). `d` lies below `m / 2^16` by less than one unit
+/// (`2^-15` of it), so `2^45 / d` exceeds `2^61 / m` by less than `2^-15 (1 + 2^-14)`; the quotient's floor (of a
+/// value of at least `2^16`) and `2^32 - 1` for `2^32` lower it by less than `2^-16 + 2^-32`: the seed errs by less
+/// than `2^-15 (1 + 2^-14)` either way, inside the `2^-14.8` the step's bound assumes (checked over `m` in the tests).
+pub(crate) struct Divide;
+
+impl FreshSeed for Divide {
+    #[inline(always)]
+    fn seed61(m: u32) -> i32 {
+        // `m >= 2^31`, so bit 15 of `m >> 16` is already set: the OR only tells the compiler the divisor is not 0.
+        let d =
+            core::num::NonZeroU32::new((m >> 16) | 1 << 15).unwrap_or(core::num::NonZeroU32::MIN);
+        ((0xFFFF_FFFF / d) << 13) as i32
+    }
+}
+
+/// `2^61 / m` for `m` in `[2^31, 2^32)`: the seed `S`, then one Newton-Raphson step: `< 2^-27.6` ([`FreshSeed`]).
 #[inline(always)]
-pub(crate) fn fresh61(m: u32) -> i32 {
-    const T: [(u32, u32); CELLS] = seed_table();
-    let (y, drop) = T[((m >> 24) & 127) as usize];
-    let u = (m >> 15) & 511;
-    newton::<false>(m, (y - ((drop * u) >> 9)) as i32)
+pub(crate) fn fresh61<S: FreshSeed>(m: u32) -> i32 {
+    newton::<false>(m, S::seed61(m))
 }
 
 /// `2^X / tau`, fresh (no previous pixel).
 #[inline(always)]
-fn fresh<const UP: bool>(tau: u32) -> i32 {
+fn fresh<const UP: bool, S: FreshSeed>(tau: u32) -> i32 {
     // Up: 2^60 / tau = 2^61 / (2 tau), and 2 tau is in [2^31, 2^32).
-    fresh61(if UP { tau << 1 } else { tau })
+    fresh61::<S>(if UP { tau << 1 } else { tau })
 }
 
 /// One Newton-Raphson step on `2^X / tau` from the seed `xs`.
@@ -208,10 +248,17 @@ fn slope<const UP: bool>(x: i32, delta: i32) -> i32 {
 const CHAIN_DOWN: u64 = 1 << (23 + 32);
 const CHAIN_UP: u64 = 1 << (22 + 32);
 
+/// Whether a binade whose step is `dv` chains (`r <= 2^-8`). Renormalising downward doubles the step, so a binade
+/// that does not chain is never followed by one that does when `T` falls.
+#[inline(always)]
+fn chains<const UP: bool>(dv: i64) -> bool {
+    dv.unsigned_abs() <= if UP { CHAIN_UP } else { CHAIN_DOWN }
+}
+
 /// Draws one `Less`, depth-write span whose every pixel is in range and whose step is tame (`|dt| <= T_min / 4`).
 /// `t0` is the first pixel's `T` (`t 2^frac`), `dt` the step. Fails are reported to `runs`, passing runs filled.
 #[inline(always)]
-pub(crate) fn span<D: DrawTarget>(
+pub(crate) fn span<S: FreshSeed, D: DrawTarget>(
     row: &mut [u16],
     t0: u64,
     dt: i64,
@@ -230,20 +277,20 @@ pub(crate) fn span<D: DrawTarget>(
         } else {
             (v, dv, l0)
         };
-        walk::<true, D>(row, v, dv, lz, frac, runs)
+        walk::<true, S, D>(row, v, dv, lz, frac, runs)
     } else {
         let (v, dv, lz) = if v >> 63 == 0 {
             (v << 1, dv << 1, l0 + 1)
         } else {
             (v, dv, l0)
         };
-        walk::<false, D>(row, v, dv, lz, frac, runs)
+        walk::<false, S, D>(row, v, dv, lz, frac, runs)
     }
 }
 
 /// The pixels of a span, binade by binade. State between pixels: in a passing run (`x`, `dx` current) or not.
 #[inline(always)]
-fn walk<const UP: bool, D: DrawTarget>(
+fn walk<const UP: bool, S: FreshSeed, D: DrawTarget>(
     row: &mut [u16],
     mut v: u64,
     mut dv: i64,
@@ -258,18 +305,32 @@ fn walk<const UP: bool, D: DrawTarget>(
     let crossed = left_binade::<UP>;
     'bins: loop {
         let b = Bin::new::<UP>(frac, lz);
-        let chain = dv.unsigned_abs() <= if UP { CHAIN_UP } else { CHAIN_DOWN };
+        let chain = chains::<UP>(dv);
         loop {
             if k >= n {
                 break 'bins;
             }
             if in_run {
                 // Passing run: reciprocal, code, test, store (one loop per mode, chosen per binade).
-                let (failed, cross) = if chain {
-                    run::<UP, true>(&mut row[k..], &mut k, &mut v, dv, &mut x, &mut dx, &b)
+                let end = if chain {
+                    let r = chain_run::<UP>(&mut row[k..], v, dv as u64, x, dx, b.round, b.s);
+                    (v, x, dx) = (r.v, r.x, r.dx);
+                    k += r.k;
+                    r.end
                 } else {
-                    run::<UP, false>(&mut row[k..], &mut k, &mut v, dv, &mut x, &mut dx, &b)
+                    let (n, vv, end) =
+                        fresh_run::<UP, S>(&mut row[k..], v, dv as u64, b.round, b.s);
+                    v = vv;
+                    k += n;
+                    // Should the next binade chain (only upward, where the renormalised step halves), its loop
+                    // extrapolates from the last pixel drawn: that pixel's reciprocal, in this binade's scale.
+                    if UP && end == End::Binade && chains::<UP>(dv >> 1) {
+                        x = fresh::<UP, S>((v.wrapping_sub(dv as u64) >> 32) as u32);
+                        dx = slope::<UP>(x, (dv >> 32) as i32);
+                    }
+                    end
                 };
+                let (failed, cross) = (end == End::Fail, end == End::Binade);
                 if cross {
                     renormalise::<UP>(&mut v, &mut dv, &mut lz, &mut x, &mut dx);
                     continue 'bins;
@@ -288,23 +349,10 @@ fn walk<const UP: bool, D: DrawTarget>(
             } else {
                 // Not in a run: the prefilter alone, until a pixel it cannot rule out.
                 let start = k;
-                let (mut maybe, mut left) = (false, false);
-                let mut it = row[k..].iter();
-                let mut vv = v;
-                for stored in it.by_ref() {
-                    if !b.fails((vv >> 32) as u32, *stored) {
-                        maybe = true;
-                        break;
-                    }
-                    vv = vv.wrapping_add(dv as u64);
-                    if left_binade::<UP>(vv) {
-                        left = true;
-                        break;
-                    }
-                }
+                let (skipped, vv, end) = skip_run::<UP>(&row[k..], v, dv as u64, b.lim);
                 v = vv;
-                // The pixel that broke the loop was consumed by the iterator unless the row ended.
-                k = n - it.len() - usize::from(maybe);
+                k += skipped;
+                let (maybe, left) = (end == End::Fail, end == End::Binade);
                 runs.fail_many(start, k)?;
                 if left {
                     renormalise::<UP>(&mut v, &mut dv, &mut lz, &mut x, &mut dx);
@@ -315,7 +363,7 @@ fn walk<const UP: bool, D: DrawTarget>(
                 }
                 // Pixel k: a fresh reciprocal and the real test.
                 let tau = (v >> 32) as u32;
-                x = fresh::<UP>(tau);
+                x = fresh::<UP, S>(tau);
                 dx = slope::<UP>(x, (dv >> 32) as i32);
                 let c = b.code(x);
                 if c < row[k] {
@@ -434,47 +482,99 @@ fn by_65535_signed(x: i64) -> i64 {
     x + (x >> 16) + (x >> 32) + (x >> 48)
 }
 
-/// The passing run from `row[0]` (pixel `*k` of the span): until a pixel fails (`(true, _)`, `*k` at it, `v` not
-/// stepped past it), `tau` leaves the binade (`(_, true)`, `*k` and `v` past the last pixel drawn), or the row ends.
-#[inline(always)]
-fn run<const UP: bool, const CHAIN: bool>(
+/// How a passing run ended: at a failing pixel (not drawn, not stepped past), with `tau` leaving its binade (past
+/// the last pixel drawn), or at the end of the row.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum End {
+    Fail,
+    Binade,
+    Row,
+}
+
+/// A chained run's state on leaving: pixels drawn, `v` and the reciprocal state after them, and why it ended.
+struct ChainEnd {
+    k: usize,
+    v: u64,
+    x: i32,
+    dx: i32,
+    end: End,
+}
+
+/// The prefilter alone from `row[0]`, out of line like the runs: pixels whose stored code rules them out
+/// ([`ruled_out`] with the binade's limit `lim`) are skipped. Returns the pixels skipped, `v` after them, and how it
+/// ended: at a pixel the prefilter cannot rule out (`End::Fail`, not stepped past), with `tau` leaving its binade,
+/// or at the end of the row.
+#[inline(never)]
+fn skip_run<const UP: bool>(row: &[u16], mut v: u64, dv: u64, lim: u32) -> (usize, u64, End) {
+    for (k, &stored) in row.iter().enumerate() {
+        if !ruled_out((v >> 32) as u32, stored, lim) {
+            return (k, v, End::Fail);
+        }
+        v = v.wrapping_add(dv);
+        if left_binade::<UP>(v) {
+            return (k + 1, v, End::Binade);
+        }
+    }
+    (row.len(), v, End::Row)
+}
+
+/// The passing run from `row[0]` with a fresh reciprocal per pixel: its own function, so that its few live values
+/// (`v`, its step, the row, the code's rounding and shift) stay in registers. Returns the pixels drawn, `v` after
+/// them, and how it ended ([`End`]).
+#[inline(never)]
+fn fresh_run<const UP: bool, S: FreshSeed>(
     row: &mut [u16],
-    k: &mut usize,
-    v: &mut u64,
-    dv: i64,
-    x: &mut i32,
-    dx: &mut i32,
-    b: &Bin,
-) -> (bool, bool) {
-    let (mut vv, mut xx, mut dd) = (*v, *x, *dx);
-    let mut out = (false, false);
-    let n = row.len();
-    let mut it = row.iter_mut();
-    for stored in it.by_ref() {
-        let tau = (vv >> 32) as u32;
-        let xn = if CHAIN {
-            newton::<UP>(tau, xx.wrapping_add(dd))
-        } else {
-            fresh::<UP>(tau)
-        };
-        dd = xn.wrapping_sub(xx);
-        xx = xn;
-        let c = b.code(xx);
+    mut v: u64,
+    dv: u64,
+    round: u32,
+    s: u32,
+) -> (usize, u64, End) {
+    for (k, stored) in row.iter_mut().enumerate() {
+        let x = fresh::<UP, S>((v >> 32) as u32);
+        let c = ((x as u32).wrapping_add(round) >> s) as u16;
         if c >= *stored {
-            out.0 = true;
+            return (k, v, End::Fail);
+        }
+        *stored = c;
+        v = v.wrapping_add(dv);
+        if left_binade::<UP>(v) {
+            return (k + 1, v, End::Binade);
+        }
+    }
+    (row.len(), v, End::Row)
+}
+
+/// The passing run from `row[0]` with the reciprocal carried from pixel to pixel (`x` the previous pixel's, `dx` its
+/// difference): the chained loop, out of line like [`fresh_run`].
+#[inline(never)]
+fn chain_run<const UP: bool>(
+    row: &mut [u16],
+    mut v: u64,
+    dv: u64,
+    mut x: i32,
+    mut dx: i32,
+    round: u32,
+    s: u32,
+) -> ChainEnd {
+    let mut end = End::Row;
+    let mut k = 0;
+    for stored in row.iter_mut() {
+        let xn = newton::<UP>((v >> 32) as u32, x.wrapping_add(dx));
+        let c = ((xn as u32).wrapping_add(round) >> s) as u16;
+        if c >= *stored {
+            end = End::Fail;
             break;
         }
         *stored = c;
-        vv = vv.wrapping_add(dv as u64);
-        if left_binade::<UP>(vv) {
-            out.1 = true;
+        (dx, x) = (xn.wrapping_sub(x), xn);
+        v = v.wrapping_add(dv);
+        k += 1;
+        if left_binade::<UP>(v) {
+            end = End::Binade;
             break;
         }
     }
-    // The failing pixel was consumed by the iterator but not drawn.
-    *k += n - it.len() - usize::from(out.0);
-    (*v, *x, *dx) = (vv, xx, dd);
-    out
+    ChainEnd { k, v, x, dx, end }
 }
 
 /// Whether stepping `v` left the binade: the top bit set (up) or cleared (down).
@@ -517,15 +617,22 @@ mod tests {
     }
 
     /// The fresh reciprocal over every 2^7-th `m` of `[2^31, 2^32)` and both ends of every cell, two-sided, against
-    /// the exact `2^61 / m`: within `2^-27.6` (its derivation, at `fresh61`), which is inside the tier's bound.
+    /// the exact `2^61 / m`: within `2^-27.6` (its derivation, at `fresh61`), which is inside the tier's bound; and
+    /// each seed within the `2^-14.8` that derivation assumes.
     #[test]
     fn fresh_reciprocal_holds_its_bound() {
+        fresh_holds::<Chord>("chord");
+        fresh_holds::<Divide>("divide");
+    }
+
+    fn fresh_holds<S: FreshSeed>(name: &str) {
         let bound = 2f64.powf(-27.6);
         assert!(bound < FAST_MAX_REL_ERROR);
-        let mut worst = 0.0f64;
+        let (mut worst, mut worst_seed) = (0.0f64, 0.0f64);
         let mut check = |m: u32| {
             let exact = 2f64.powi(61) / m as f64;
-            worst = worst.max((fresh61(m) as f64 / exact - 1.0).abs());
+            worst = worst.max((fresh61::<S>(m) as f64 / exact - 1.0).abs());
+            worst_seed = worst_seed.max((S::seed61(m) as f64 / exact - 1.0).abs());
         };
         let mut m: u64 = 1 << 31;
         while m < 1 << 32 {
@@ -537,8 +644,20 @@ mod tests {
             check(lo as u32);
             check((lo + (1 << 24) - 1) as u32);
         }
-        std::println!("fresh: worst {:.2} bits, bound 27.6", -worst.log2());
+        std::println!(
+            "fresh ({name}): worst {:.2} bits, bound 27.6; seed {:.2} bits, bound 14.8",
+            -worst.log2(),
+            -worst_seed.log2()
+        );
         assert!(worst <= bound, "{worst:e}");
+        assert!(worst_seed <= 2f64.powf(-14.8), "{worst_seed:e}");
+        if name == "divide" {
+            // The division seed's own derivation: below 2^-15 (1 + 2^-14).
+            assert!(
+                worst_seed < 2f64.powi(-15) * (1.0 + 2f64.powi(-14)),
+                "{worst_seed:e}"
+            );
+        }
     }
 
     /// The set-up's bit count and wide product equal `leading_zeros` and the `u64` product (all single bits, their
@@ -627,7 +746,7 @@ mod tests {
     /// Chained spans: `tau` walked as the loop walks it (64 bits, renormalised per binade), `x` carried by the
     /// extrapolated seed and one step wherever the binade allows chaining, fresh elsewhere; every pixel's `x` against
     /// the exact `2^X / tau` of the exact 64-bit value, within [`FAST_MAX_REL_ERROR`]. Returns (pixels, chained).
-    fn sweep<const UP: bool>() -> (u64, u64) {
+    fn sweep<const UP: bool, S: FreshSeed>() -> (u64, u64) {
         let mut state = 0x2545_F491_4F6C_DD1D_u64;
         let (mut pixels, mut chained, mut worst) = (0u64, 0u64, 0.0f64);
         for _ in 0..3000 {
@@ -647,14 +766,17 @@ mod tests {
                 if dv.unsigned_abs() > v >> 2 {
                     break;
                 }
-                let chain = dv.unsigned_abs() <= if UP { CHAIN_UP } else { CHAIN_DOWN };
+                let chain = chains::<UP>(dv);
                 let tau = (v >> 32) as u32;
                 let xn = if have && chain {
                     newton::<UP>(tau, x.wrapping_add(dx))
                 } else if have {
-                    fresh::<UP>(tau)
+                    // The fresh loop's last pixel, and the slope the chained loop of the next binade starts from.
+                    let f = fresh::<UP, S>(tau);
+                    x = f.wrapping_sub(slope::<UP>(f, (dv >> 32) as i32));
+                    f
                 } else {
-                    let f = fresh::<UP>(tau);
+                    let f = fresh::<UP, S>(tau);
                     dx = slope::<UP>(f, (dv >> 32) as i32);
                     x = f.wrapping_sub(dx); // so that dx = xn - x below
                     f
@@ -686,7 +808,12 @@ mod tests {
 
     #[test]
     fn chained_and_fresh_spans_hold_the_bound() {
-        for (pixels, chained) in [sweep::<true>(), sweep::<false>()] {
+        for (pixels, chained) in [
+            sweep::<true, Chord>(),
+            sweep::<false, Chord>(),
+            sweep::<true, Divide>(),
+            sweep::<false, Divide>(),
+        ] {
             assert!(chained > pixels / 4, "the sweep must exercise chaining");
         }
     }
@@ -725,7 +852,7 @@ mod tests {
     }
 
     /// The prefilter never rules out a pixel whose computed code is below the stored one: for random `tau` on a
-    /// binade and stored codes around the computed one, `fails` implies `code >= stored`.
+    /// binade and stored codes around the computed one, `ruled_out` implies `code >= stored`.
     #[test]
     fn prefilter_is_conservative() {
         let mut state = 0x9E37_79B9_7F4A_7C15_u64;
@@ -741,15 +868,15 @@ mod tests {
             }
             let (b, tau, x) = if up {
                 let tau = (1u32 << 30) | (rnd(&mut state) as u32 >> 2);
-                (Bin::new::<true>(frac, lz), tau, fresh::<true>(tau))
+                (Bin::new::<true>(frac, lz), tau, fresh::<true, Chord>(tau))
             } else {
                 let tau = (1u32 << 31) | (rnd(&mut state) as u32 >> 1);
-                (Bin::new::<false>(frac, lz), tau, fresh::<false>(tau))
+                (Bin::new::<false>(frac, lz), tau, fresh::<false, Chord>(tau))
             };
             let code = b.code(x) as i32;
             for d in -3..=3 {
                 let stored = (code + d).clamp(0, 65535) as u16;
-                if b.fails(tau, stored) {
+                if ruled_out(tau, stored, b.lim) {
                     tested += 1;
                     assert!(
                         code >= stored as i32,

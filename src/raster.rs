@@ -29,6 +29,7 @@ use embedded_graphics_core::primitives::Rectangle;
 
 use crate::depth::{encode_w16, DepthBuffer, W16_FAR};
 use crate::edge::{Edge, Sub};
+use crate::fast::{Chord, Divide};
 use crate::fixed::{div_u128, round_shift, split};
 use crate::input::VertexInput;
 #[cfg(feature = "gouraud")]
@@ -417,7 +418,13 @@ impl<R: SpanRecip> Rasterizer<R> {
             s.fast_t = t_at_snapped(&s);
         }
         if R::FAST_W16 && cmp == Compare::Less && write && !self.state.has_bias() {
-            if let Some(stats) = crate::small::draw(target, depth, &s, &self.state, v[0].color())? {
+            // The strategy's seed (a constant of `R`: the other branch is not compiled into the firmware).
+            let small = if R::DIV_SEED {
+                crate::small::draw::<Divide, D>(target, depth, &s, &self.state, v[0].color())?
+            } else {
+                crate::small::draw::<Chord, D>(target, depth, &s, &self.state, v[0].color())?
+            };
+            if let Some(stats) = small {
                 return Ok(stats);
             }
         }
@@ -658,7 +665,7 @@ fn depth_plane(
 /// vertices off the snap grid.
 #[inline(never)] // once per triangle: out of line, one copy (flash)
 pub(crate) fn t_at_snapped(s: &Setup) -> Option<[i64; 3]> {
-    use crate::fast::{bits64, fresh61, mul_wide};
+    use crate::fast::{bits64, fresh61, mul_wide, Chord};
     let (p, q, t) = (s.p, s.q, s.t);
     // `a b` exactly for `|a| < 2^63`, `|b| < 2^31`, as (sign, magnitude): two 32 x 32 -> 64 products.
     #[inline(always)]
@@ -717,9 +724,9 @@ pub(crate) fn t_at_snapped(s: &Setup) -> Option<[i64; 3]> {
     let a = area.unsigned_abs();
     let la = 64 - bits64(a);
     let m = ((a << la) >> 32) as u32; // in [2^31, 2^32): a = m 2^(32 - la), truncated
-    let x = fresh61(m) as u32; // about 2^61 / m
-                               // The gradient's numerators `g = (d1 e2y - d2 e1y, d2 e1x - d1 e2x)`, exact (below 2^94), each divided by the
-                               // area as `gh x 2^(sg + la - 93)` (`gh x` below 2^62), kept as its top 32 bits `G` and exponent `sg + la - 61`.
+    let x = fresh61::<Chord>(m) as u32; // about 2^61 / m (set-up: one seed for every strategy)
+                                        // The gradient's numerators `g = (d1 e2y - d2 e1y, d2 e1x - d1 e2x)`, exact (below 2^94), each divided by the
+                                        // area as `gh x 2^(sg + la - 93)` (`gh x` below 2^62), kept as its top 32 bits `G` and exponent `sg + la - 61`.
     let (d1, d2) = (t[1] - t[0], t[2] - t[0]);
     let grad = |g: (bool, u128)| -> (bool, u32, i32) {
         if g.1 == 0 {
@@ -1133,7 +1140,11 @@ fn span<R: SpanRecip, D: DrawTarget>(
         && write
         && ctx.bias() == 0
     {
-        crate::fast::span(row, t, dt, 94 - ctx.shift_base, runs)?;
+        if R::DIV_SEED {
+            crate::fast::span::<Divide, D>(row, t, dt, 94 - ctx.shift_base, runs)?;
+        } else {
+            crate::fast::span::<Chord, D>(row, t, dt, 94 - ctx.shift_base, runs)?;
+        }
     } else if tame && in_range(t) && in_range(last) {
         recip.begin_span(smooth);
         // The comparison is chosen once per span: the default (Less) gets its own loop, the rest share one.

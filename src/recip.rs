@@ -235,6 +235,9 @@ pub trait SpanRecip: Default {
     const MAX_REL_ERROR: f64;
     /// Whether W16 spans with the `Less` test take the fast tier's loop (`crate::fast`) instead of this reciprocal.
     const FAST_W16: bool = false;
+    /// With [`SpanRecip::FAST_W16`]: whether the fast tier's fresh reciprocal is seeded by one 32-bit division
+    /// ([`FastDiv`]) instead of a 128-cell table ([`Fast`]).
+    const DIV_SEED: bool = false;
     /// Before the first pixel of a span; `smooth` as defined at [`SMOOTH_SHIFT`].
     #[inline(always)]
     fn begin_span(&mut self, _smooth: bool) {}
@@ -278,6 +281,25 @@ impl SpanRecip for Fast {
     const MAX_REL_ERROR: f64 =
         crate::fast::FAST_MAX_REL_ERROR.max(PerPixel::<DefaultRecip>::MAX_REL_ERROR);
     const FAST_W16: bool = true;
+    #[inline(always)]
+    fn recip(&mut self, m: u32) -> u32 {
+        DefaultRecip::recip(m)
+    }
+}
+
+/// The fast tier seeded by division, for cores with a divide instruction (Cortex-M3/M4/M7, RV32IM): the same loops,
+/// bound and contract as [`Fast`], with the fresh reciprocal's seed `2^13 floor((2^32 - 1) / floor(m / 2^16))` (one
+/// `UDIV`, below `2^-15 (1 + 2^-14)`) instead of the 128-cell table (below `2^-14.8`): fewer instructions a fresh
+/// pixel and no table in flash. Its frames differ from [`Fast`]'s in rare last-bit roundings, and are the same on
+/// every core (on the Cortex-M0, which has no divide instruction, the division is a library call: correct, slow).
+#[derive(Default)]
+pub struct FastDiv;
+
+impl SpanRecip for FastDiv {
+    const NAME: &'static str = "fast-div";
+    const MAX_REL_ERROR: f64 = Fast::MAX_REL_ERROR;
+    const FAST_W16: bool = true;
+    const DIV_SEED: bool = true;
     #[inline(always)]
     fn recip(&mut self, m: u32) -> u32 {
         DefaultRecip::recip(m)

@@ -51,7 +51,7 @@ use embedded_graphics_core::primitives::Rectangle;
 use crate::depth::DepthBuffer;
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
-use crate::fast::{bits64 as bits, fresh61, lz_small, mul_hi, mul_wide, MIN_SPAN};
+use crate::fast::{bits64 as bits, fresh61, lz_small, mul_hi, mul_wide, FreshSeed, MIN_SPAN};
 use crate::raster::{rows_of, Setup, Stats, SUBPIXEL_BITS};
 use crate::state::{Cull, RenderState};
 use crate::Error;
@@ -67,7 +67,7 @@ fn margin(t_max: u64) -> u64 {
 /// `Less`, depth write and no bias (the caller's conditions). `Ok(None)`, having written nothing, where it does not
 /// apply: the general path then draws it.
 #[inline(never)]
-pub(crate) fn draw<D: DrawTarget>(
+pub(crate) fn draw<S: FreshSeed, D: DrawTarget>(
     target: &mut D,
     depth: &mut DepthBuffer<'_>,
     s: &Setup,
@@ -218,7 +218,7 @@ pub(crate) fn draw<D: DrawTarget>(
             let h = (v >> 32) as u32;
             let lz = lz_small(h);
             let m = (h << lz) | ((v as u32) >> (32 - lz));
-            let hi = mul_hi(kn, fresh61(m) as u32);
+            let hi = mul_hi(kn, fresh61::<S>(m) as u32);
             let c = (((hi >> (s0 - lz - 1)) + 1) >> 1) as u16;
             let ok = c < *stored;
             if ok {

@@ -142,7 +142,7 @@ fn interpenetrating_surfaces_at_a_grazing_angle_resolve_outside_the_two_lsb_band
 #[test]
 fn depth_comes_from_the_vertices_as_given_on_grazing_triangles() {
     use host_tests::{reference_tri, snap, Rng};
-    use wraster::recip::{Exact, Fast, SpanRecip};
+    use wraster::recip::{Exact, Fast, FastDiv, SpanRecip};
     use wraster::Compare;
     fn run<R: SpanRecip>(tie: f64) -> (u64, u64, u64, i64, f64) {
         let mut rng = Rng(77);
@@ -202,6 +202,7 @@ fn depth_comes_from_the_vertices_as_given_on_grazing_triangles() {
     }
     for (name, (pixels, exact, over, worst, grid_max)) in [
         ("fast", run::<Fast>(2f64.powf(-11.1))),
+        ("fast-div", run::<FastDiv>(2f64.powf(-11.1))),
         ("exact", run::<Exact>(2f64.powi(-12))),
     ] {
         println!(

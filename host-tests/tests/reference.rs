@@ -199,6 +199,17 @@ fn fast_tier_within_one_lsb_and_999_exact() {
     depth_suite::<wraster::recip::Fast>(Compare::Less, "fast tier", 1.0 - 2.0 * 2f64.powf(-11.1));
 }
 
+/// The fast tier seeded by division (`FastDiv`, the M4's and RV32's default): the same loops and the same derived
+/// bound (its seed is below `2^-15 (1 + 2^-14)`, inside the `2^-14.8` the bound assumes), so the same contract.
+#[test]
+fn fast_div_tier_within_one_lsb_and_999_exact() {
+    depth_suite::<wraster::recip::FastDiv>(
+        Compare::Less,
+        "fast-div tier",
+        1.0 - 2.0 * 2f64.powf(-11.1),
+    );
+}
+
 /// A random small triangle: a box of 1 to 127 px (log-uniform) anywhere over the 96 x 64 frame (so partly outside it
 /// too), vertices on sub-pixel ties or pixel centres a quarter of the time each, both windings, and depths within a
 /// factor `ratio` (log-uniform up to 64) of each other around a depth anywhere in `[wmin, wmax]`.
@@ -231,19 +242,24 @@ fn small_tri(rng: &mut Rng, wmin: f64, wmax: f64) -> [Vertex<Rgb565>; 3] {
 /// loop's `5.9e-9`, inside the tier's `2^-27.2`).
 #[test]
 fn fast_tier_small_triangles_cover_and_hold_the_contract() {
+    small_suite::<wraster::recip::Fast>("fast tier");
+}
+
+/// The same 100,000 small triangles with the division-seeded fast tier (`FastDiv`): the same bound and contract.
+#[test]
+fn fast_div_tier_small_triangles_cover_and_hold_the_contract() {
+    small_suite::<wraster::recip::FastDiv>("fast-div tier");
+}
+
+fn small_suite<R: SpanRecip>(name: &str) {
     let mut all = 0;
     for (k, far) in [10.0f32, 100.0, 1000.0, 1.0e4].into_iter().enumerate() {
-        let t = compare_each_of::<wraster::recip::Fast>(
-            Compare::Less,
-            900 + k as u64,
-            25_000,
-            1.0,
-            far,
-            |rng| small_tri(rng, 0.8, far as f64 * 1.25),
-        );
+        let t = compare_each_of::<R>(Compare::Less, 900 + k as u64, 25_000, 1.0, far, |rng| {
+            small_tri(rng, 0.8, far as f64 * 1.25)
+        });
         let frac = t.exact as f64 / t.pixels as f64;
         println!(
-            "fast tier, small triangles, far/near={far}: {} pixels, {} exact ({:.5}%), max diff {}",
+            "{name}, small triangles, far/near={far}: {} pixels, {} exact ({:.5}%), max diff {}",
             t.pixels,
             t.exact,
             100.0 * frac,
@@ -260,7 +276,7 @@ fn fast_tier_small_triangles_cover_and_hold_the_contract() {
         );
         all += t.pixels;
     }
-    println!("fast tier, small triangles: {all} pixels over 100,000 triangles");
+    println!("{name}, small triangles: {all} pixels over 100,000 triangles");
 }
 
 /// The previous-pixel seed: bound 2^-21.98 (recip.rs), so codes err by at most 65535 * 2^-21.98 < 2^-5.9 LSB:

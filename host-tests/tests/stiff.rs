@@ -7,7 +7,7 @@
 
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
 use host_tests::{reference_tri, Frame, Rng};
-use wraster::recip::{DefaultRecip, F32Div, Fast, PerPixel, PrevPixel, SpanRecip};
+use wraster::recip::{DefaultRecip, F32Div, Fast, FastDiv, PerPixel, PrevPixel, SpanRecip};
 use wraster::{Compare, DepthBuffer, Error, Rasterizer, RenderState, Vertex, W16_FAR};
 
 /// Draws `tri` alone (with `cmp`: `Always`, or `Less` into the cleared buffer) in a `w x h` buffer and checks it against
@@ -146,6 +146,9 @@ fn both(tri: [Vertex<Rgb565>; 3], near: f32, far: f32, w: u16, h: u16) -> Tally 
     let (q, _) = check::<PerPixel<F32Div>>(tri, near, far, w, h, a, TIE_F32);
     assert_eq!(p, q);
     let (fast, fast_exact) = check::<Fast>(tri, near, far, w, h, Compare::Less, TIE_FAST);
+    // The division-seeded fast tier: the same bound, so the same tie distance.
+    let (q, _) = check::<FastDiv>(tri, near, far, w, h, Compare::Less, TIE_FAST);
+    assert_eq!(fast, q);
     Tally {
         pixels: p,
         exact,

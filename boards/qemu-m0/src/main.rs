@@ -19,7 +19,7 @@ use wraster::recip::Fast;
 #[cfg(not(feature = "torus"))]
 use wraster::recip::SpanRecip;
 #[cfg(any(not(feature = "size-probe"), feature = "torus"))]
-use wraster::recip::{Exact, PrevPixel};
+use wraster::recip::{Exact, FastDiv, PrevPixel};
 #[cfg(not(feature = "torus"))]
 use wraster_board::run_all;
 #[cfg(not(any(feature = "size-probe", feature = "torus")))]
@@ -102,6 +102,7 @@ fn main() -> ! {
         )
     }
     let ok = torus::<Fast>(COLOR, DEPTH, VERTS, &mut counter)
+        & torus::<FastDiv>(COLOR, DEPTH, VERTS, &mut counter)
         & torus::<Exact>(COLOR, DEPTH, VERTS, &mut counter)
         & torus::<PrevPixel>(COLOR, DEPTH, VERTS, &mut counter);
     debug::exit(if ok {
@@ -124,7 +125,10 @@ fn main() -> ! {
     let ok = all::<Fast>(COLOR, DEPTH, &mut counter);
     // `--features size-probe` runs the default strategy only (profiles, cycle estimates: boards/tools/cycles.py).
     #[cfg(not(feature = "size-probe"))]
+    // The other strategies for the hash test (`FastDiv`, the M4's and RV32's default: its division is a library
+    // call on this core, which has no divide instruction).
     let ok = ok
+        & all::<FastDiv>(COLOR, DEPTH, &mut counter)
         & all::<Exact>(COLOR, DEPTH, &mut counter)
         & all::<PrevPixel>(COLOR, DEPTH, &mut counter)
         & band_overhead(COLOR, DEPTH, &mut counter);

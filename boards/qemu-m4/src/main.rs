@@ -1,7 +1,8 @@
 //! wraster on QEMU `mps2-an386` (Cortex-M4F, thumbv7em-none-eabihf), memory map from the top-level `memory.x`.
 //!
 //! Renders every standard scene (or, with `--features torus`, W4's torus) (`wraster::scenes`, baked by `wraster-board`) whole-frame (320x240 colour and W16
-//! depth in RAM, one band), with the default reciprocal and with the previous-pixel seed, prints one `bench` line per
+//! depth in RAM, one band), with this core's default (`FastDiv`: the fast tier seeded by `UDIV`), then the table-seeded fast tier, the exact
+//! tier and the previous-pixel seed, prints one `bench` line per
 //! run over semihosting and exits 0; any error or panic exits non-zero.
 //! Run: `cd boards/qemu-m4 && cargo run --release` (the runner in `.cargo/config.toml` adds `-icount shift=0`).
 //!
@@ -16,8 +17,10 @@ use cortex_m_semihosting::{debug, hprintln};
 use panic_semihosting as _;
 use wraster::mesh::Projected;
 #[cfg(not(feature = "size-probe"))]
+use wraster::recip::Fast;
+#[cfg(not(feature = "size-probe"))]
 use wraster::recip::{Exact, PrevPixel};
-use wraster::recip::{Fast, SpanRecip};
+use wraster::recip::{FastDiv, SpanRecip};
 use wraster::scenes::torus::VERTICES;
 #[cfg(not(feature = "torus"))]
 use wraster_board::run_all;
@@ -59,10 +62,13 @@ fn main() -> ! {
     }; VERTICES];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 40, 1);
-    let ok = all::<Fast>(COLOR, DEPTH, VERTS, &mut counter);
+    // This core's default: the fast tier seeded by its divide instruction.
+    let ok = all::<FastDiv>(COLOR, DEPTH, VERTS, &mut counter);
     // `--features size-probe` links the default path only, to measure the library's share of .text (README).
+    // The other strategies run for the hash test: each strategy's frames agree across cores.
     #[cfg(not(feature = "size-probe"))]
     let ok = ok
+        & all::<Fast>(COLOR, DEPTH, VERTS, &mut counter)
         & all::<Exact>(COLOR, DEPTH, VERTS, &mut counter)
         & all::<PrevPixel>(COLOR, DEPTH, VERTS, &mut counter);
     // `--features f32-div` adds the f32-division reciprocal (one VDIV on this core), for comparison (README).

@@ -12,7 +12,7 @@
 use riscv_rt::entry;
 use riscv_semihosting::{debug, hprintln};
 use wraster::mesh::Projected;
-use wraster::recip::{Exact, Fast, PrevPixel, SpanRecip};
+use wraster::recip::{Exact, Fast, FastDiv, PrevPixel, SpanRecip};
 use wraster::scenes::torus::VERTICES;
 #[cfg(not(feature = "torus"))]
 use wraster_board::run_all;
@@ -64,7 +64,9 @@ fn main() -> ! {
     // The frame lives on the stack (riscv-rt gives it the top of the 16 MiB RAM): no `static mut`, no unsafe.
     let (mut color, mut depth) = ([0u16; PIXELS], [0u16; PIXELS]);
     let mut verts = [Projected::default(); VERTICES];
-    let ok = all::<Fast>(&mut color, &mut depth, &mut verts)
+    // This core's default first (RV32IM has DIVU: the division-seeded fast tier), then the others for the hash test.
+    let ok = all::<FastDiv>(&mut color, &mut depth, &mut verts)
+        & all::<Fast>(&mut color, &mut depth, &mut verts)
         & all::<Exact>(&mut color, &mut depth, &mut verts)
         & all::<PrevPixel>(&mut color, &mut depth, &mut verts);
     debug::exit(if ok {
