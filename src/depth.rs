@@ -69,6 +69,7 @@ impl<'a> DepthBuffer<'a> {
         }
         Some(self.data[r as usize * self.width as usize + x as usize])
     }
+    #[inline]
     pub(crate) fn row_mut(&mut self, y: i32) -> &mut [u16] {
         let r = (y - self.y0) as usize * self.width as usize;
         &mut self.data[r..r + self.width as usize]

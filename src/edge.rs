@@ -146,6 +146,64 @@ impl Edge {
     }
 }
 
+/// One edge's column bound on the current row, walked row by row as [`Edge`] walks `q`: `b = -q` for a left edge (the
+/// first column it admits), `b = q + 1` for a right edge (one past the last), so that a step is `b += sb`, and
+/// `b += inc` on a carry of the remainder. The small triangles' row loop (`crate::small`) keeps three of these in
+/// fixed slots instead of matching on [`Side`] per row.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Bound {
+    pub b: i32,
+    r: i32,
+    d: i32,
+    sb: i32,
+    sr: i32,
+    inc: i32,
+}
+
+impl Bound {
+    /// A bound that never binds and never moves: a lower bound for a horizontal edge's slot.
+    pub const NONE: Bound = Bound {
+        b: i32::MIN / 2,
+        r: 0,
+        d: 1,
+        sb: 0,
+        sr: 0,
+        inc: 0,
+    };
+
+    /// The edge's bound and side ([`Bound::NONE`] for a horizontal edge).
+    #[inline(always)]
+    pub fn of(e: &Edge) -> (Side, Bound) {
+        let (b, sb, inc) = match e.side {
+            Side::Left => (-e.q, -e.step_q, -1),
+            Side::Right => (e.q + 1, e.step_q, 1),
+            Side::Flat => return (Side::Flat, Bound::NONE),
+        };
+        (
+            e.side,
+            Bound {
+                b,
+                r: e.r,
+                d: e.d,
+                sb,
+                sr: e.step_r,
+                inc,
+            },
+        )
+    }
+
+    /// Moves to the next row (the walk of [`Edge::step`]).
+    #[inline(always)]
+    pub fn step(&mut self) {
+        self.b += self.sb;
+        self.r += self.sr;
+        if self.r >= self.d {
+            self.r -= self.d;
+            self.b += self.inc;
+        }
+    }
+}
+
 /// The rows `(first, last)` of a triangle with positive doubled area (`p` oriented), from the rows whose centre lies
 /// in its vertices' y-range, less the row whose centres lie exactly on a horizontal bottom edge: with `A = 0` and
 /// `B < 0` (interior above) the edge is not top-left, and its `N = B (256 j + 128 - y) - 1` is negative exactly from

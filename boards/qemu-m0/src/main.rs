@@ -18,7 +18,7 @@ use panic_semihosting as _;
 use wraster::recip::Fast;
 #[cfg(not(feature = "torus"))]
 use wraster::recip::SpanRecip;
-#[cfg(any(not(feature = "size-probe"), feature = "torus"))]
+#[cfg(not(feature = "size-probe"))]
 use wraster::recip::{Exact, FastDiv, PrevPixel};
 #[cfg(not(feature = "torus"))]
 use wraster_board::run_all;
@@ -101,7 +101,10 @@ fn main() -> ! {
             |line| hprintln!("{}", line),
         )
     }
-    let ok = torus::<Fast>(COLOR, DEPTH, VERTS, &mut counter)
+    let ok = torus::<Fast>(COLOR, DEPTH, VERTS, &mut counter);
+    // `--features size-probe`: the default strategy only (profiles).
+    #[cfg(not(feature = "size-probe"))]
+    let ok = ok
         & torus::<FastDiv>(COLOR, DEPTH, VERTS, &mut counter)
         & torus::<Exact>(COLOR, DEPTH, VERTS, &mut counter)
         & torus::<PrevPixel>(COLOR, DEPTH, VERTS, &mut counter);
