@@ -134,9 +134,10 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
         mix: &impl Fn([C; 3], [f32; 3]) -> C,
         mut f: impl FnMut([Vertex<C>; 3]) -> Result<Stats, E>,
     ) -> Result<(), E> {
-        // Rows whose centre can be covered: y in [y0 + 0.5, y0 + h - 0.5]; a pixel of slack for the snap. Compared
-        // as ordered integers (`key`): a float compare is a library call on a core without an FPU.
-        let (top, bottom) = (key(y0 as f32 - 1.0), key((y0 + h as i32) as f32 + 1.0));
+        // Rows whose centre can be covered: y in [y0 + 0.5, y0 + h - 0.5], less 0.01 px of slack for the snap (which
+        // moves y by at most 1/512 px) and the bounds' own rounding (below 2^-11 px for |y| < 2^12). Compared as
+        // ordered integers (`key`): a float compare is a library call on a core without an FPU.
+        let (top, bottom) = (key(y0 as f32 + 0.49), key((y0 + h as i32) as f32 - 0.49));
         for (k, tri) in self.mesh.indices.iter().enumerate() {
             let idx = tri.map(|i| i as usize);
             let [a, b, c] = idx.map(|i| self.verts[i]);

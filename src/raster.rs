@@ -414,7 +414,14 @@ impl<R: SpanRecip> Rasterizer<R> {
     {
         let (cmp, write) = self.w16_test()?;
         let mut s = self.setup(v)?;
-        if R::FAST_W16 && !s.on_grid {
+        // Only for a triangle with rows in the buffer (a band's draws include triangles that only come near it):
+        // one that has none draws nothing either way, and both paths find that before they look at `fast_t`.
+        let (first, last) = rows_of(&s.p);
+        if R::FAST_W16
+            && !s.on_grid
+            && first < depth.y0() + depth.height() as i32
+            && last >= depth.y0()
+        {
             s.fast_t = t_at_snapped(&s);
         }
         if R::FAST_W16 && cmp == Compare::Less && write && !self.state.has_bias() {

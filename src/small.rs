@@ -49,10 +49,10 @@ use embedded_graphics_core::prelude::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 
 use crate::depth::DepthBuffer;
+use crate::edge::{flat_rows, Bound, Edge, Side, Sub};
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
 use crate::fast::{bits64 as bits, fresh61, lz_small, mul_hi, mul_wide, FreshSeed, MIN_SPAN};
-use crate::edge::{flat_rows, Bound, Edge, Side, Sub};
 use crate::raster::{rows_of, Setup, Stats, SUBPIXEL_BITS};
 use crate::state::{Cull, RenderState};
 use crate::Error;
@@ -246,8 +246,20 @@ impl Dda {
         ];
         let left = |k: usize| matches!(e[k].side, Side::Left);
         let right = |k: usize| matches!(e[k].side, Side::Right);
-        let li = if left(0) { 0 } else if left(1) { 1 } else { 2 };
-        let ri = if right(0) { 0 } else if right(1) { 1 } else { 2 };
+        let li = if left(0) {
+            0
+        } else if left(1) {
+            1
+        } else {
+            2
+        };
+        let ri = if right(0) {
+            0
+        } else if right(1) {
+            1
+        } else {
+            2
+        };
         if !left(li) || !right(ri) {
             return None;
         }
@@ -493,7 +505,9 @@ mod tests {
             if !setup.on_grid {
                 setup.fast_t = t_at_snapped(&setup);
             }
-            let base: Vec<u16> = (0..64 * 64).map(|_| 20_000 + (rnd() % 40_000) as u16).collect();
+            let base: Vec<u16> = (0..64 * 64)
+                .map(|_| 20_000 + (rnd() % 40_000) as u16)
+                .collect();
             let band = if k % 5 < 2 { 64 } else { 5 };
             let y0 = if band == 64 { 0 } else { (rnd() % 60) as i32 };
             let mut out = [(vec![], vec![], None), (vec![], vec![], None)];
@@ -502,12 +516,40 @@ mod tests {
                 let mut f = Frame(vec![0; 64 * 64]);
                 let mut db = DepthBuffer::band(&mut d, 64, y0, band as u16).unwrap();
                 let st = match (m, k % 4 == 1) {
-                    (0, false) => draw_as::<Chord, _, true>(&mut f, &mut db, &setup, &r.state, BinaryColor::On),
-                    (1, false) => draw_as::<Chord, _, false>(&mut f, &mut db, &setup, &r.state, BinaryColor::On),
-                    (0, true) => draw_as::<Divide, _, true>(&mut f, &mut db, &setup, &r.state, BinaryColor::On),
-                    _ => draw_as::<Divide, _, false>(&mut f, &mut db, &setup, &r.state, BinaryColor::On),
+                    (0, false) => draw_as::<Chord, _, true>(
+                        &mut f,
+                        &mut db,
+                        &setup,
+                        &r.state,
+                        BinaryColor::On,
+                    ),
+                    (1, false) => draw_as::<Chord, _, false>(
+                        &mut f,
+                        &mut db,
+                        &setup,
+                        &r.state,
+                        BinaryColor::On,
+                    ),
+                    (0, true) => draw_as::<Divide, _, true>(
+                        &mut f,
+                        &mut db,
+                        &setup,
+                        &r.state,
+                        BinaryColor::On,
+                    ),
+                    _ => draw_as::<Divide, _, false>(
+                        &mut f,
+                        &mut db,
+                        &setup,
+                        &r.state,
+                        BinaryColor::On,
+                    ),
                 };
-                *o = (d, f.0, st.unwrap().map(|s| (s.fragments, s.written, s.culled)));
+                *o = (
+                    d,
+                    f.0,
+                    st.unwrap().map(|s| (s.fragments, s.written, s.culled)),
+                );
             }
             assert_eq!(out[0], out[1], "triangle {k}: {v:?}");
             if let Some((fr, _, _)) = out[0].2 {
