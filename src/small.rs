@@ -564,8 +564,8 @@ mod tests {
                 pixels += fr;
             }
         }
-        // A guard that the comparison exercises the path: most triangles are taken (15,526 of 20,000 when written),
-        // and they cover tens of thousands of pixels (35,743).
-        assert!(taken > 10_000 && pixels > 20_000, "{taken} {pixels}");
+        // A guard that the comparison exercises the path: most triangles are taken (17,434 of 20,000 when written),
+        // and they cover many pixels (104,494).
+        assert!(taken > 10_000 && pixels > 50_000, "{taken} {pixels}");
     }
 }
