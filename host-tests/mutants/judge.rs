@@ -20,6 +20,8 @@ mod fixed_input;
 mod formats;
 #[path = "../tests/fuzz_regressions.rs"]
 mod fuzz_regressions;
+#[path = "../tests/golden.rs"]
+mod golden;
 #[path = "../tests/gouraud.rs"]
 mod gouraud;
 #[path = "../tests/grazing.rs"]

@@ -636,3 +636,38 @@ pub const COMPARES: [wraster::Compare; 8] = [
     wraster::Compare::GreaterEqual,
     wraster::Compare::Always,
 ];
+
+/// Every standard scene and W4 rendered whole-frame with the strategy `R`, each frame hashed as the boards hash it
+/// ([`hash_frame`]; W4's 8 frames in one hash): `(scene, R::NAME) -> (hash, written, fragments)` into `out`.
+pub fn scene_hashes<R: SpanRecip>(
+    out: &mut std::collections::HashMap<(String, String), (u64, u32, u32)>,
+) {
+    use wraster::scenes::{torus, Scene, HEIGHT, WIDTH};
+    for scene in Scene::ALL {
+        let (near, far) = scene.depth_range();
+        let tris: Vec<_> = scene.tris().collect();
+        let (frame, depth, stats) = render::<R>(
+            &tris,
+            RenderState::new(near, far).unwrap(),
+            WIDTH,
+            HEIGHT,
+            HEIGHT,
+        )
+        .unwrap();
+        let mut h = 0xcbf2_9ce4_8422_2325u64;
+        hash_frame(&mut h, &frame, &depth);
+        out.insert(
+            (scene.name().into(), R::NAME.into()),
+            (h, stats.written, stats.fragments),
+        );
+    }
+    // W4: the 8 torus frames through the mesh path, one hash over all of them in order.
+    let (mut h, mut written, mut fragments) = (0xcbf2_9ce4_8422_2325u64, 0, 0);
+    for k in 0..torus::FRAMES {
+        let (frame, depth, stats) = render_torus::<R>(k, HEIGHT).unwrap();
+        hash_frame(&mut h, &frame, &depth);
+        written += stats.written;
+        fragments += stats.fragments;
+    }
+    out.insert(("torus".into(), R::NAME.into()), (h, written, fragments));
+}

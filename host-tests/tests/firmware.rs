@@ -12,41 +12,8 @@
 
 use std::collections::HashMap;
 
-use host_tests::{hash_frame, have, render, render_torus, run_board};
-use wraster::recip::{Exact, Fast, FastDiv, PrevPixel, SpanRecip};
-use wraster::scenes::{torus, Scene, HEIGHT, WIDTH};
-use wraster::RenderState;
-
-/// `(scene, recip) -> (hash, written, fragments)` on the host.
-fn host_runs<R: SpanRecip>(out: &mut HashMap<(String, String), (u64, u32, u32)>) {
-    for scene in Scene::ALL {
-        let (near, far) = scene.depth_range();
-        let tris: Vec<_> = scene.tris().collect();
-        let (frame, depth, stats) = render::<R>(
-            &tris,
-            RenderState::new(near, far).unwrap(),
-            WIDTH,
-            HEIGHT,
-            HEIGHT,
-        )
-        .unwrap();
-        let mut h = 0xcbf2_9ce4_8422_2325u64;
-        hash_frame(&mut h, &frame, &depth);
-        out.insert(
-            (scene.name().into(), R::NAME.into()),
-            (h, stats.written, stats.fragments),
-        );
-    }
-    // W4: the 8 torus frames through the mesh path, one hash over all of them in order.
-    let (mut h, mut written, mut fragments) = (0xcbf2_9ce4_8422_2325u64, 0, 0);
-    for k in 0..torus::FRAMES {
-        let (frame, depth, stats) = render_torus::<R>(k, HEIGHT).unwrap();
-        hash_frame(&mut h, &frame, &depth);
-        written += stats.written;
-        fragments += stats.fragments;
-    }
-    out.insert(("torus".into(), R::NAME.into()), (h, written, fragments));
-}
+use host_tests::{have, run_board, scene_hashes};
+use wraster::recip::{Exact, Fast, FastDiv, PrevPixel};
 
 #[test]
 fn boards_render_the_hosts_frames_bit_for_bit() {
@@ -67,10 +34,10 @@ fn boards_render_the_hosts_frames_bit_for_bit() {
         return;
     }
     let mut host = HashMap::new();
-    host_runs::<Fast>(&mut host);
-    host_runs::<FastDiv>(&mut host);
-    host_runs::<Exact>(&mut host);
-    host_runs::<PrevPixel>(&mut host);
+    scene_hashes::<Fast>(&mut host);
+    scene_hashes::<FastDiv>(&mut host);
+    scene_hashes::<Exact>(&mut host);
+    scene_hashes::<PrevPixel>(&mut host);
 
     // Each board builds the standard scenes, and W4 with `--features torus` (on the M0, 60 bands: its vertex store
     // takes 6 KiB of the 16).
