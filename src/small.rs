@@ -712,4 +712,85 @@ mod tests {
         );
         assert!(share >= 1.0 - 2f64.powf(-10.3), "{share}");
     }
+
+    /// Which triangles the path takes, at the edges of its conditions (module doc), on the snap grid, with the range
+    /// `[1, 64]` (`t = 64 rhw` exact): a vertex exactly on the far plane (`T_min = 2^F`, inside the range but not
+    /// by the margin) or the near plane (`T_max = t_hi`), `T_max / T_min` exactly 32 (`T_min = 2^56`: taken) and
+    /// just over it, a box exactly 32 px wide or 126 px high (declined) and one sub-pixel less (taken). A declined
+    /// triangle is left to the general path (`None`, nothing written).
+    #[test]
+    fn takes_and_declines_at_its_limits() {
+        let r = Rasterizer::<Fast>::new(RenderState::new(1.0, 64.0).unwrap());
+        let taken = |v: [(f32, f32, f32); 3]| {
+            let v = v.map(|(x, y, rhw)| Vertex {
+                x,
+                y,
+                z: 0.0,
+                rhw,
+                color: BinaryColor::On,
+            });
+            let setup = r.setup(&v).unwrap();
+            assert!(setup.on_grid);
+            let mut d = vec![u16::MAX; 64 * 192];
+            let mut f = Frame(vec![0; 64 * 192]);
+            let mut db = DepthBuffer::new(&mut d, 64, 192).unwrap();
+            let st = draw::<Chord, _>(&mut f, &mut db, &setup, &r.state, BinaryColor::On).unwrap();
+            if st.is_none() {
+                assert!(d.iter().all(|&c| c == u16::MAX) && f.0.iter().all(|&c| c == 0));
+            }
+            st.is_some_and(|s| s.written > 0)
+        };
+        let w = |w: f32| 1.0 / w;
+        // Inside by far more than the margin.
+        assert!(taken([
+            (10.5, 10.5, w(2.0)),
+            (20.5, 12.5, w(3.0)),
+            (14.5, 20.5, w(4.0))
+        ]));
+        // A vertex on the far plane (t = 1), the others near it (T_max / T_min < 2).
+        assert!(!taken([
+            (10.5, 10.5, w(64.0)),
+            (20.5, 12.5, w(40.0)),
+            (14.5, 20.5, w(50.0))
+        ]));
+        // A vertex on the near plane (t = 64).
+        assert!(!taken([
+            (10.5, 10.5, w(1.0)),
+            (20.5, 12.5, w(1.5)),
+            (14.5, 20.5, w(1.25))
+        ]));
+        // T_max / T_min: t in {2, 32, 42.67}, F = 61 - bits(42) = 55, so T_min = 2^56 exactly: taken; t_min one
+        // f32 step below 2 (rhw = 2^-5 (1 - 2^-24), exact): declined.
+        assert!(taken([
+            (10.5, 10.5, w(32.0)),
+            (20.5, 12.5, w(2.0)),
+            (14.5, 20.5, w(1.5))
+        ]));
+        let below = f32::from_bits(w(32.0).to_bits() - 1);
+        assert_eq!(below as f64, (1.0 - 2f64.powi(-24)) / 32.0);
+        assert!(!taken([
+            (10.5, 10.5, below),
+            (20.5, 12.5, w(2.0)),
+            (14.5, 20.5, w(1.5))
+        ]));
+        // The box: 32 px wide or 126 px high is declined; one sub-pixel less is taken.
+        let wide = |x: f32| {
+            [
+                (10.5, 10.5, w(2.0)),
+                (x, 14.5, w(3.0)),
+                (14.5, 20.5, w(4.0)),
+            ]
+        };
+        assert!(!taken(wide(42.5)));
+        assert!(taken(wide(42.5 - 1.0 / 256.0)));
+        let high = |y: f32| {
+            [
+                (10.5, 10.5, w(2.0)),
+                (20.5, 12.5, w(3.0)),
+                (14.5, y, w(4.0)),
+            ]
+        };
+        assert!(!taken(high(136.5)));
+        assert!(taken(high(136.5 - 1.0 / 256.0)));
+    }
 }
