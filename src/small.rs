@@ -577,7 +577,8 @@ mod tests {
     /// `T_max / T_min <= 11 < 32`), over a random stored surface, whole frame and bands of 5 rows.
     /// - It takes every such triangle with rows in the buffer (`Some`), both seeds, by division and by scanning.
     /// - The same counts: covered pixels (`fragments`) and culled triangles, exactly (coverage and culling are exact).
-    /// - Every stored code within 1 of the exact tier's, and the written colour the same wherever the codes agree.
+    /// - Every stored code within 1 of the exact tier's, the written colour the same wherever the codes agree, and
+    ///   the same count written where all agree; the same triangle drawn again writes nothing (`Less` is strict).
     /// - At least 99.9% of the compared codes equal. Derived: against the true plane, this path's code errs by below
     ///   `2^-11.3` LSB (`5.91e-9` relative, module doc) and the exact tier's by below `2^-12`; both are the correctly
     ///   rounded code unless the true value lies within `2^-11.3` of a rounding tie, a window of `2^-10.3` of the
@@ -693,9 +694,19 @@ mod tests {
                         equal += u64::from(diff == 0);
                     }
                 }
+                if d == de {
+                    assert_eq!(st.written, se.written, "triangle {k} {m}");
+                }
                 if m == 0 {
                     taken += 1;
                     culled += st.culled;
+                    // `Less` is strict: the same triangle again writes nothing.
+                    let mut again = Frame(vec![0; 64 * 192]);
+                    let mut db = DepthBuffer::band(&mut d, 64, y0, band as u16).unwrap();
+                    let st2 =
+                        draw::<Chord, _>(&mut again, &mut db, &setup, &state, BinaryColor::On);
+                    assert_eq!(st2.unwrap().map(|s| s.written), Some(0), "triangle {k}");
+                    assert!(again.0.iter().all(|&c| c == 0), "triangle {k}");
                 }
             }
         }
