@@ -804,4 +804,75 @@ mod tests {
         assert!(!taken(high(136.5)));
         assert!(taken(high(136.5 - 1.0 / 256.0)));
     }
+
+    /// The path's codes, pinned (a golden test, as `host-tests/tests/golden.rs` pins whole frames): 20,000 random
+    /// triangles of boxes up to 24 px, on and off the snap grid, near the far plane (`W` in `[55, 100]`, range
+    /// `[1, 100]`, so codes of 36,000 to 65,535; 874,364 codes), each drawn into a cleared buffer; FNV-1a over every written code,
+    /// per seed. The accuracy tests judge the codes within the tier's derived bound, so a change of one unit of
+    /// `2^-32` in a term of it (a rounding made a truncation) passes them; it moves some `5 10^-5` of these codes
+    /// (those within `2^-31 65535` LSB of a rounding tie; some 40 here) and so this hash. A deliberate change to the path's
+    /// arithmetic updates the hashes (printed with `--nocapture`).
+    #[test]
+    fn golden_codes() {
+        fn run<S: FreshSeed>() -> (u64, u64) {
+            let r = Rasterizer::<Fast>::new(RenderState::new(1.0, 100.0).unwrap());
+            let mut s: u64 = 0x6A09_E667_F3BC_C909;
+            let mut rnd = move || {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                s
+            };
+            let mut unit = move || (rnd() >> 11) as f32 / (1u64 << 53) as f32;
+            let (mut hash, mut codes) = (0xcbf2_9ce4_8422_2325u64, 0u64);
+            let mut d = vec![u16::MAX; 64 * 64];
+            for k in 0..20_000 {
+                let (cx, cy) = (unit() * 36.0 + 2.0, unit() * 36.0 + 2.0);
+                let grid = |v: f32| {
+                    if k % 2 == 0 {
+                        (v * 256.0).round() / 256.0
+                    } else {
+                        v
+                    }
+                };
+                let v: [Vertex<BinaryColor>; 3] = core::array::from_fn(|_| Vertex {
+                    x: grid(cx + unit() * 24.0),
+                    y: grid(cy + unit() * 24.0),
+                    z: 0.0,
+                    rhw: 1.0 / (55.0 + unit() * 45.0),
+                    color: BinaryColor::On,
+                });
+                let mut setup = r.setup(&v).unwrap();
+                if !setup.on_grid {
+                    setup.fast_t = t_at_snapped(&setup);
+                }
+                d.fill(u16::MAX);
+                let mut f = Frame(vec![0; 64 * 64]);
+                let mut db = DepthBuffer::new(&mut d, 64, 64).unwrap();
+                if draw::<S, _>(&mut f, &mut db, &setup, &r.state, BinaryColor::On)
+                    .unwrap()
+                    .is_none()
+                {
+                    continue;
+                }
+                for &c in d.iter().filter(|&&c| c != u16::MAX) {
+                    for b in c.to_le_bytes() {
+                        hash = (hash ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
+                    }
+                    codes += 1;
+                }
+            }
+            (hash, codes)
+        }
+        let (chord, divide) = (run::<Chord>(), run::<Divide>());
+        std::println!(
+            "golden codes: chord {:016x} {}, divide {:016x} {}",
+            chord.0,
+            chord.1,
+            divide.0,
+            divide.1
+        );
+        assert_eq!(chord, (0x2f72_95ba_4bdb_8736, 874_364));
+        assert_eq!(divide, (0xe641_d086_58d6_e953, 874_364));
+    }
 }
