@@ -805,6 +805,30 @@ mod tests {
         assert!(taken(high(136.5 - 1.0 / 256.0)));
     }
 
+    /// The code's shift `s0 - lz` must stay below 32, and `s0` is about `14 + bits(t_max)` (`sh`, `kz` and `F` of the
+    /// module doc), so near the near plane of a deep range (`t` about `2^19` in `[1, 2^20]`) the path declines the
+    /// triangle (the general path draws it), and takes the same triangle in `[1, 2^16]`.
+    #[test]
+    fn declines_a_shift_past_32_bits() {
+        for (far, take) in [(1048576.0f32, false), (65536.0, true)] {
+            let r = Rasterizer::<Fast>::new(RenderState::new(1.0, far).unwrap());
+            let v =
+                [(10.5, 10.5, 2.0), (20.5, 12.5, 3.0), (14.5, 20.5, 2.5)].map(|(x, y, w)| Vertex {
+                    x,
+                    y,
+                    z: 0.0,
+                    rhw: 1.0 / w,
+                    color: BinaryColor::On,
+                });
+            let setup = r.setup(&v).unwrap();
+            let mut d = vec![u16::MAX; 64 * 64];
+            let mut f = Frame(vec![0; 64 * 64]);
+            let mut db = DepthBuffer::new(&mut d, 64, 64).unwrap();
+            let st = draw::<Chord, _>(&mut f, &mut db, &setup, &r.state, BinaryColor::On).unwrap();
+            assert_eq!(st.is_some(), take, "far {far}");
+        }
+    }
+
     /// The path's codes, pinned (a golden test, as `host-tests/tests/golden.rs` pins whole frames): 20,000 random
     /// triangles of boxes up to 24 px, on and off the snap grid, near the far plane (`W` in `[55, 100]`, range
     /// `[1, 100]`, so codes of 36,000 to 65,535; 874,364 codes), each drawn into a cleared buffer; FNV-1a over every written code,
