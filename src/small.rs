@@ -805,6 +805,47 @@ mod tests {
         assert!(taken(high(136.5 - 1.0 / 256.0)));
     }
 
+    /// The range margin's value: a vertex inside the far plane by less than the margin is declined. `W_far` has the
+    /// mantissa `2^23 - 2892` and the vertex's `1/W` the mantissa `2^23 + 2893`, so `t = 1 + 22052 2^-46` exactly (the
+    /// product of the two); with `t_max = 1.3457` (`F = 60`), `T_min - 2^60 = 22052 2^14 = 361,299,968` lies between
+    /// `T_max >> 32 = 361,233,596` and the margin `361,233,596 + 2^17`: declined; a margin without its `2^17` term
+    /// (or any smaller one) would take it.
+    #[test]
+    fn declines_a_vertex_inside_the_far_plane_by_less_than_the_margin() {
+        let far = f32::from_bits(0x427f_e968);
+        let r = Rasterizer::<Fast>::new(RenderState::new(1.0, far).unwrap());
+        let v = [
+            (10.5, 10.5, f32::from_bits(0x3c80_0b4d)),
+            (20.5, 12.5, f32::from_bits(0x3cac_4f1b)),
+            (14.5, 20.5, f32::from_bits(0x3c99_a729)),
+        ]
+        .map(|(x, y, rhw)| Vertex {
+            x,
+            y,
+            z: 0.0,
+            rhw,
+            color: BinaryColor::On,
+        });
+        let setup = r.setup(&v).unwrap();
+        assert_eq!(setup.frac, 60);
+        let t = setup.t.map(|t| t as u64);
+        assert_eq!(t[0] - (1 << 60), 22052 << 14);
+        assert_eq!(t[1] >> 32, 361_233_596);
+        assert_eq!(margin(t[1]), 361_233_596 + (1 << 17));
+        let mut d = vec![u16::MAX; 64 * 64];
+        let mut f = Frame(vec![0; 64 * 64]);
+        let mut db = DepthBuffer::new(&mut d, 64, 64).unwrap();
+        let st = draw::<Chord, _>(&mut f, &mut db, &setup, &r.state, BinaryColor::On).unwrap();
+        assert!(st.is_none());
+        // Moved inside by more than the margin (t = 1 + 2^-22 + ...), the same triangle is taken.
+        let mut v2 = v;
+        v2[0].rhw = f32::from_bits(0x3c80_0b4d + 64);
+        let setup = r.setup(&v2).unwrap();
+        let mut db = DepthBuffer::new(&mut d, 64, 64).unwrap();
+        let st = draw::<Chord, _>(&mut f, &mut db, &setup, &r.state, BinaryColor::On).unwrap();
+        assert!(st.is_some());
+    }
+
     /// The code's shift `s0 - lz` must stay below 32, and `s0` is about `14 + bits(t_max)` (`sh`, `kz` and `F` of the
     /// module doc), so near the near plane of a deep range (`t` about `2^19` in `[1, 2^20]`) the path declines the
     /// triangle (the general path draws it), and takes the same triangle in `[1, 2^16]`.
