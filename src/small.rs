@@ -846,12 +846,19 @@ mod tests {
         assert!(st.is_some());
     }
 
-    /// The code's shift `s0 - lz` must stay below 32, and `s0` is about `14 + bits(t_max)` (`sh`, `kz` and `F` of the
-    /// module doc), so near the near plane of a deep range (`t` about `2^19` in `[1, 2^20]`) the path declines the
-    /// triangle (the general path draws it), and takes the same triangle in `[1, 2^16]`.
+    /// The code's shift `s0 - lz` (`lz >= 1`) must stay below 32, and `s0` grows with `bits(t_max)` (`sh`, `kz` and
+    /// `F` of the module doc), so near the near plane of a deep range the path declines the triangle (the general path
+    /// draws it): with `W` in `[2, 3]` and the range `[1, W_far]`, `W_far = 2^20` and `2^19` give `s0 = 34` and `33`
+    /// (declined), `2^18` exactly 32 and `2^16` 30 (taken).
     #[test]
     fn declines_a_shift_past_32_bits() {
-        for (far, take) in [(1048576.0f32, false), (65536.0, true)] {
+        // s0 = 34, 33, 32 and 30 (measured by a print in `draw_as`).
+        for (far, take) in [
+            (1048576.0f32, false),
+            (524288.0, false),
+            (262144.0, true),
+            (65536.0, true),
+        ] {
             let r = Rasterizer::<Fast>::new(RenderState::new(1.0, far).unwrap());
             let v =
                 [(10.5, 10.5, 2.0), (20.5, 12.5, 3.0), (14.5, 20.5, 2.5)].map(|(x, y, w)| Vertex {
