@@ -764,6 +764,31 @@ pub fn state_target(data: &[u8]) {
         |_| Rgb565::new(31, 63, 31),
         &mut outv,
     );
+    // `row_range` (binning triangles into bands): no panic; an error only where the draw of the same vertices errs
+    // too (it checks x and y as the draw does); otherwise every row the draw writes lies in the range.
+    let tri: [Vertex<Rgb565>; 3] = core::array::from_fn(|_| {
+        Vertex::new(b.f32(), b.f32(), 1.0 + b.u8() as f32, Rgb565::new(31, 0, 0))
+    });
+    let mut canvas = Canvas::new(64, 64);
+    let mut d = vec![u16::MAX; 64 * 64];
+    let drawn = Rasterizer::<Fast>::new(RenderState::new(1.0, 300.0).unwrap()).draw(
+        &mut canvas,
+        &mut DepthBuffer::new(&mut d, 64, 64).unwrap(),
+        &tri,
+    );
+    match wraster::row_range(&tri) {
+        Err(e) => assert!(drawn.is_err(), "row_range {e:?}, draw {drawn:?}"),
+        Ok((first, last)) => {
+            for j in 0..64 {
+                if d[j * 64..(j + 1) * 64].iter().any(|&c| c != u16::MAX) {
+                    assert!(
+                        first <= j as i32 && j as i32 <= last,
+                        "row {j} outside {first}..={last}"
+                    );
+                }
+            }
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------------------
