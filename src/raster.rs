@@ -1259,4 +1259,23 @@ mod tests {
         assert_eq!(div_round(7, 2), 4);
         assert_eq!(div_round(-5, 3), -2);
     }
+
+    /// The depth grid's fraction bits are the finest that keep a box's positions in 31 bits: `(extent + 2) 2^bits`
+    /// below `2^31`, and one bit more would reach it, for every extent up to the guard band's 8192 px; the
+    /// documented values: 29 within one pixel, 24 under 126 px, 17 for the largest boxes.
+    #[test]
+    fn depth_grid_bits_is_the_finest_in_31_bits() {
+        for e in 0..=8192i32 {
+            let b = depth_grid_bits(e);
+            let span = (e as u64 + 2) << b;
+            assert!(
+                span < 1 << 31 && span << 1 >= 1 << 31,
+                "extent {e}: {b} bits"
+            );
+        }
+        assert_eq!(
+            [0, 1, 5, 6, 125, 126, 8192].map(depth_grid_bits),
+            [29, 29, 28, 27, 24, 23, 17]
+        );
+    }
 }
