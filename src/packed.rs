@@ -930,3 +930,30 @@ mod float_bits_tests {
         assert_eq!(float_bits((1 << 25) - 1, 0, 23), 33_554_432f32.to_bits());
     }
 }
+
+#[cfg(test)]
+mod zconst_tests {
+    use super::ZConst;
+    use crate::DepthRange;
+
+    /// `rz60` is `(t - 1) n / (f - n) 2^60` within the constant's truncation (`2^-31` relative) and the final shift's
+    /// floor, for `T = t 2^frac` with a small `frac` (a triangle with a vertex very near the eye, `t` up to `2^40`),
+    /// where the product is shifted left (`s + frac < 60`: a narrow range `[10, 11]`, `s = 29`), and a large one.
+    #[test]
+    fn rz60_is_the_reversed_z_for_any_fraction_bits() {
+        let zc = ZConst::new(&DepthRange::new(10.0, 11.0).unwrap());
+        for frac in [20u32, 28, 40, 60] {
+            for k in 0..=100u64 {
+                // t from 1 (the far plane) to 1.1 (the near plane), exactly representable in `frac` bits
+                let t = (1u64 << frac) + ((k << frac) / 1000);
+                let exact =
+                    (t - (1 << frac)) as f64 / (1u64 << frac) as f64 * 10.0 * (1u64 << 60) as f64;
+                let got = zc.rz60(t, frac) as f64;
+                assert!(
+                    (got - exact).abs() <= exact * 2f64.powi(-30) + 2.0,
+                    "frac {frac} t {t}: {got} vs {exact}"
+                );
+            }
+        }
+    }
+}
