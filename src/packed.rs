@@ -958,12 +958,13 @@ mod zconst_tests {
     }
 
     /// The linear-Z value `(W - n) / (f - n)` at a vertex beyond the far plane (`W = 25` in `[10, 20]`: 1.5, so
-    /// `rz60` is negative there and must not be clamped to 0) and one inside (`W = 15`: 0.5), in Q0.60.
+    /// `rz60` is negative there and must not be clamped to 0), one inside (`W = 15`: 0.5) and one in front of the
+    /// near plane (`W = 5`: -0.5, kept negative), in Q0.60.
     #[test]
     fn linear_z_beyond_the_far_plane() {
         let zc = ZConst::new(&DepthRange::new(10.0, 20.0).unwrap());
         let frac = 40;
-        for (t, want) in [(0.8f64, 1.5f64), (20.0 / 15.0, 0.5)] {
+        for (t, want) in [(0.8f64, 1.5f64), (20.0 / 15.0, 0.5), (4.0, -0.5)] {
             let tt = (t * (1u64 << frac) as f64) as i64;
             let got = super::linear_z60(&zc, tt, frac) as f64 / (1u64 << 60) as f64;
             assert!((got - want).abs() < 1e-8, "t {t}: {got} vs {want}");
