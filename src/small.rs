@@ -454,6 +454,17 @@ mod tests {
     use std::vec;
     use std::vec::Vec;
 
+    /// A xorshift64 generator. The closure is `Copy`: a copy goes on from the same state, so a view such as
+    /// `unit` below, made from a copy, repeats the sequence rather than sharing it.
+    fn xorshift(mut s: u64) -> impl FnMut() -> u64 + Copy {
+        move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        }
+    }
+
     /// A frame 64 pixels wide of `BinaryColor` pixels (0 unwritten), recording every pixel written.
     struct Frame(Vec<u8>);
     impl OriginDimensions for Frame {
@@ -482,13 +493,7 @@ mod tests {
     /// holding a random surface (so some pixels fail), with both seeds.
     #[test]
     fn division_and_scan_find_the_same_runs() {
-        let mut s: u64 = 0x9E37_79B9_7F4A_7C15;
-        let mut rnd = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
+        let mut rnd = xorshift(0x9E37_79B9_7F4A_7C15);
         let mut unit = move || (rnd() >> 11) as f32 / (1u64 << 53) as f32;
         let r = Rasterizer::<Fast>::new(RenderState::new(1.0, 100.0).unwrap());
         let (mut taken, mut pixels) = (0, 0u32);
@@ -585,15 +590,9 @@ mod tests {
     ///   codes for uniformly spread fractions: at least `1 - 2^-10.3 = 99.92%` agree.
     #[test]
     fn agrees_with_the_exact_tier_and_takes_what_it_should() {
-        let mut s: u64 = 0x2545_F491_4F6C_DD1D;
-        let mut rnd = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
+        let mut rnd = xorshift(0x2545_F491_4F6C_DD1D);
         let mut unit = move || (rnd() >> 11) as f32 / (1u64 << 53) as f32;
-        let mut surface = 0x9E37_79B9_7F4A_7C15u64;
+        let mut surface = xorshift(0x9E37_79B9_7F4A_7C15);
         let (mut taken, mut culled, mut compared, mut equal) = (0u32, 0u32, 0u64, 0u64);
         for k in 0..12_000 {
             let cull = [Cull::None, Cull::Cw, Cull::Ccw][k % 3];
@@ -619,12 +618,7 @@ mod tests {
                 setup.fast_t = t_at_snapped(&setup);
             }
             let base: Vec<u16> = (0..64 * 192)
-                .map(|_| {
-                    surface ^= surface << 13;
-                    surface ^= surface >> 7;
-                    surface ^= surface << 17;
-                    1_000 + (surface % 64_000) as u16
-                })
+                .map(|_| 1_000 + (surface() % 64_000) as u16)
                 .collect();
             let band = if k % 5 < 2 { 192 } else { 5 };
             let y0 = if band == 192 { 0 } else { (rnd() % 188) as i32 };
@@ -888,13 +882,7 @@ mod tests {
     fn golden_codes() {
         fn run<S: FreshSeed>() -> (u64, u64) {
             let r = Rasterizer::<Fast>::new(RenderState::new(1.0, 100.0).unwrap());
-            let mut s: u64 = 0x6A09_E667_F3BC_C909;
-            let mut rnd = move || {
-                s ^= s << 13;
-                s ^= s >> 7;
-                s ^= s << 17;
-                s
-            };
+            let mut rnd = xorshift(0x6A09_E667_F3BC_C909);
             let mut unit = move || (rnd() >> 11) as f32 / (1u64 << 53) as f32;
             let (mut hash, mut codes) = (0xcbf2_9ce4_8422_2325u64, 0u64);
             let mut d = vec![u16::MAX; 64 * 64];
