@@ -86,6 +86,76 @@ fn main() {
     .unwrap();
     let out = std::path::PathBuf::from(std::env::var("OUT_DIR").unwrap()).join("scenes.rs");
     std::fs::write(out, s).unwrap();
+    plans();
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=../../src");
+}
+
+/// The plans named by `PLAN` (comma-separated files written by host-tests' `plan` binary), each in a module `pN`,
+/// with `COUNT`, the largest depth RAM and band height among them, whether one draws the torus, and
+/// `run_all_plans`, which runs each with its own format, strategy and depth path (nothing else is linked).
+fn plans() {
+    println!("cargo:rerun-if-env-changed=PLAN");
+    let files: Vec<String> = std::env::var("PLAN")
+        .map(|v| {
+            v.split(',')
+                .filter(|f| !f.is_empty())
+                .map(String::from)
+                .collect()
+        })
+        .unwrap_or_default();
+    let mut s = String::new();
+    let mut calls = String::new();
+    let (mut ram, mut rows, mut torus) = (Vec::new(), Vec::new(), Vec::new());
+    for (k, f) in files.iter().enumerate() {
+        let path = std::fs::canonicalize(f).unwrap_or_else(|e| panic!("PLAN file {f}: {e}"));
+        println!("cargo:rerun-if-changed={}", path.display());
+        writeln!(
+            s,
+            "/// Plan {k}: `{}`.\npub mod p{k} {{\n    include!({:?});\n}}",
+            path.display(),
+            path.display()
+        )
+        .unwrap();
+        writeln!(
+            calls,
+            "    ok &= crate::run_plan_line::<p{k}::PlanFormat, p{k}::PlanStrategy, C, {{ p{k}::PLAN_KIND }}>(board, core, &p{k}::PLAN, color, depth, verts, counter, &mut *print);"
+        )
+        .unwrap();
+        ram.push(format!("p{k}::PLAN.depth_ram"));
+        rows.push(format!("if p{k}::PLAN_KIND == crate::NO_DEPTH {{ 0 }} else {{ p{k}::PLAN.band_rows as usize }}"));
+        torus.push(format!(
+            "p{k}::PLAN.scene.len() == 5 && p{k}::PLAN.scene.as_bytes()[0] == b't'"
+        ));
+    }
+    let max = |v: &[String]| {
+        v.iter()
+            .fold("0".to_string(), |acc, x| format!("max({acc}, {x})"))
+    };
+    writeln!(
+        s,
+        "#[allow(dead_code)]\nconst fn max(a: usize, b: usize) -> usize {{ if a > b {{ a }} else {{ b }} }}"
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "/// Plans baked in.\npub const COUNT: usize = {};",
+        files.len()
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "/// The largest depth RAM a plan needs, in bytes.\npub const MAX_DEPTH_RAM: usize = {};",
+        max(&ram)
+    )
+    .unwrap();
+    writeln!(s, "/// The most rows a plan's depth band has (0: no plan keeps a depth buffer).\npub const MAX_BAND_ROWS: usize = {};", max(&rows)).unwrap();
+    writeln!(s, "/// Whether a plan draws W4's torus (its vertices need RAM).\npub const HAS_TORUS: bool = false{};", torus.iter().map(|t| format!(" || {t}")).collect::<String>()).unwrap();
+    writeln!(
+        s,
+        "/// Runs every plan, printing its `bench` line; `false` when one failed.\n#[allow(unused_variables, unused_mut, clippy::let_and_return)]\npub fn run_all_plans<C: crate::Counter>(board: &str, core: &str, color: &mut [u16], depth: &mut [u16], verts: &mut [wraster::mesh::Projected], counter: &mut C, print: &mut dyn FnMut(core::fmt::Arguments<'_>)) -> bool {{\n    let mut ok = true;\n{calls}    ok\n}}"
+    )
+    .unwrap();
+    let out = std::path::PathBuf::from(std::env::var("OUT_DIR").unwrap()).join("plans.rs");
+    std::fs::write(out, s).unwrap();
 }

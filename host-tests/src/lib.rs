@@ -8,6 +8,7 @@
 //! rounded to `2^-17` to `2^-29` px by the box's size, `wraster::depth_grid_bits`) may move the depth at each pixel,
 //! so that tests can add that derived term to their bounds.
 
+pub mod plan;
 pub mod plot;
 
 use embedded_graphics::pixelcolor::Rgb565;
@@ -487,6 +488,15 @@ pub fn have(cmd: &str) -> bool {
 /// Builds and runs firmware board `board` (a directory of boards/) under QEMU with cargo `features`, from the
 /// board's directory so its target and runner (.cargo/config.toml) apply; its stdout, or why it failed.
 pub fn run_board(board: &str, features: &[&str]) -> Result<String, String> {
+    run_board_env(board, features, &[])
+}
+
+/// [`run_board`] with environment variables for its build (`PLAN=...`, say).
+pub fn run_board_env(
+    board: &str,
+    features: &[&str],
+    env: &[(&str, &str)],
+) -> Result<String, String> {
     let boards = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../boards");
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut cmd = std::process::Command::new(&cargo);
@@ -494,6 +504,7 @@ pub fn run_board(board: &str, features: &[&str]) -> Result<String, String> {
     if !features.is_empty() {
         cmd.args(["--features", &features.join(",")]);
     }
+    cmd.envs(env.iter().copied());
     let out = cmd
         .current_dir(boards.join(board))
         .env_remove("CARGO_TARGET_DIR")
@@ -567,6 +578,15 @@ pub fn render_torus<R: SpanRecip>(
     k: usize,
     band_h: u16,
 ) -> Result<(Frame, Vec<u16>, Stats), Error> {
+    render_torus_with::<R>(k, band_h, wraster::scenes::torus::camera()?.render_state()?)
+}
+
+/// [`render_torus`] with render state `state` (a plan's depth range, say).
+pub fn render_torus_with<R: SpanRecip>(
+    k: usize,
+    band_h: u16,
+    state: RenderState,
+) -> Result<(Frame, Vec<u16>, Stats), Error> {
     use wraster::clip::Viewport;
     use wraster::mesh::{Colors, Mesh, Projected};
     use wraster::scenes::{torus, HEIGHT, WIDTH};
@@ -580,7 +600,7 @@ pub fn render_torus<R: SpanRecip>(
     let (w, h) = (WIDTH, HEIGHT);
     let mut frame = Frame::new(w as u32, h as u32);
     let mut depth = vec![0u16; w as usize * h as usize];
-    let mut r = Rasterizer::<R>::new(cam.render_state()?);
+    let mut r = Rasterizer::<R>::new(state);
     let mut scratch = vec![Projected::default(); pos.len()];
     let vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
     let mf = r.transform_mesh(

@@ -10,15 +10,16 @@
 use core::fmt::Write;
 
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{OriginDimensions, Size};
+use embedded_graphics_core::geometry::{Dimensions, Point, Size};
 use embedded_graphics_core::pixelcolor::raw::RawU16;
 use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
 use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 use wraster::clip::Viewport;
+use wraster::format::W16;
 use wraster::mesh::{Colors, Mesh, Projected};
 use wraster::recip::SpanRecip;
-use wraster::{DepthBuffer, Error, Rasterizer, RenderState, Stats, Vertex};
+use wraster::{Codec, DepthBuffer, Error, Packed, Rasterizer, RenderState, Stats, Vertex};
 
 /// A baked triangle: `(x, y, rhw)` bit patterns per vertex, the RGB565 colour, the rows it can cover.
 pub struct Tri {
@@ -43,6 +44,40 @@ pub struct SceneData {
 }
 
 include!(concat!(env!("OUT_DIR"), "/scenes.rs"));
+
+/// A plan of host-tests' scene planner (`cargo run --release -p host-tests --bin plan -- <scene>`), baked by build.rs
+/// from the files named in `PLAN` (comma-separated) into modules `plans::p0`, `p1`, ... with the chosen format and
+/// strategy as the type aliases `PlanFormat` and `PlanStrategy` beside this.
+#[derive(Clone, Copy, Debug)]
+pub struct PlanData {
+    /// The scene (a standard scene's name, or `torus`).
+    pub scene: &'static str,
+    /// The format's name (`none`: no depth buffer).
+    pub format: &'static str,
+    /// `W_near` of the plan's render state.
+    pub near: f32,
+    /// `W_far`.
+    pub far: f32,
+    /// Rows per depth band.
+    pub band_rows: u16,
+    /// Bytes of depth buffer the plan needs.
+    pub depth_ram: usize,
+    /// Visibility errors the host measured for the plan.
+    pub visibility_errors: u32,
+}
+
+/// A plan's depth path (its `PLAN_KIND`, a const generic of [`run_plan`], so a firmware links only its own): no
+/// depth buffer.
+pub const NO_DEPTH: u8 = 0;
+/// The lean W16 path (`Rasterizer::draw`, the fast tier).
+pub const LEAN_W16: u8 = 1;
+/// A packed format through `Rasterizer::draw_format`.
+pub const PACKED: u8 = 2;
+
+/// The plans named by `PLAN` at build time (none without it).
+pub mod plans {
+    include!(concat!(env!("OUT_DIR"), "/plans.rs"));
+}
 
 /// Frame size of the standard scenes.
 pub const WIDTH: u16 = 320;
@@ -79,9 +114,14 @@ impl<'a> Band<'a> {
     }
 }
 
-impl OriginDimensions for Band<'_> {
-    fn size(&self) -> Size {
-        Size::new(WIDTH as u32, (self.y0 + self.h) as u32)
+// Its bounding box is its own rows, so a draw without a depth buffer (which takes its rows from the target) walks
+// only those.
+impl Dimensions for Band<'_> {
+    fn bounding_box(&self) -> Rectangle {
+        Rectangle::new(
+            Point::new(0, self.y0),
+            Size::new(WIDTH as u32, self.h as u32),
+        )
     }
 }
 
@@ -126,6 +166,13 @@ impl Default for Fnv {
 }
 
 impl Fnv {
+    /// Hashes `bytes`.
+    pub fn bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
     /// Hashes the little-endian bytes of `words`.
     pub fn words(&mut self, words: &[u16]) {
         for w in words {
@@ -277,6 +324,276 @@ pub fn run_scene_with<R: SpanRecip, C: Counter>(
         instructions,
         hash: hash.0,
     })
+}
+
+/// Hands every triangle of a frame, with its rows, to the draw it is given.
+type ForEachTri<'a> = dyn FnMut(
+        &mut dyn FnMut(&[Vertex<Rgb565>; 3], (i32, i32)) -> Result<(), Error>,
+    ) -> Result<(), Error>
+    + 'a;
+
+/// Draws `scene` with `state` into colour bands of `rows` rows (`color.len() >= WIDTH * rows`), each band with the
+/// depth buffer `F` (or none) in `depth` (bytes; only a packed format uses them) or, for W16, in `depth16`: the
+/// lean W16 path. Hash and counts as [`run_scene`]: each row's colours, then its stored depth bytes (none without
+/// a buffer).
+#[allow(clippy::too_many_arguments)]
+fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
+    tris: &mut ForEachTri<'_>,
+    plan: &PlanData,
+    state: RenderState,
+    color: &mut [u16],
+    depth: &mut [u16],
+    counter: &mut C,
+    stats: &mut Stats,
+    hash: &mut Fnv,
+) -> Result<(u64, u32), Error> {
+    let rows = if KIND == NO_DEPTH {
+        (color.len() / WIDTH as usize) as u16
+    } else {
+        plan.band_rows
+    };
+    let mut r = Rasterizer::<R>::new(state);
+    let (mut instructions, mut bands) = (0u64, 0u32);
+    let mut y0 = 0u16;
+    let w = WIDTH as usize;
+    while y0 < HEIGHT {
+        let h = rows.min(HEIGHT - y0);
+        let n = w * h as usize;
+        let color = &mut color[..n];
+        color.fill(0);
+        let mut band = Band::new(color, y0 as i32);
+        let (b0, b1) = (y0 as i32, (y0 + h) as i32 - 1);
+        if KIND == NO_DEPTH {
+            counter.start();
+            let res = tris(&mut |v, rr| {
+                if rr.0 <= b1 && rr.1 >= b0 {
+                    *stats += r.draw_format::<W16, _>(&mut band, None, v)?;
+                }
+                Ok(())
+            });
+            instructions += counter.stop();
+            res?;
+            for row in 0..h as usize {
+                hash.words(&band.px[row * w..(row + 1) * w]);
+            }
+        } else if KIND == LEAN_W16 {
+            let depth = &mut depth[..n];
+            let mut buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+            buf.clear();
+            counter.start();
+            let res = tris(&mut |v, rr| {
+                if rr.0 <= b1 && rr.1 >= b0 {
+                    *stats += r.draw(&mut band, &mut buf, v)?;
+                }
+                Ok(())
+            });
+            instructions += counter.stop();
+            res?;
+            for row in 0..h as usize {
+                hash.words(&band.px[row * w..(row + 1) * w]);
+                hash.words(&buf.data()[row * w..(row + 1) * w]);
+            }
+        } else {
+            let bytes: &mut [u8] = bytemuck::cast_slice_mut(depth);
+            let bytes = &mut bytes[..n * F::BYTES];
+            let mut buf = Packed::<F>::band(bytes, WIDTH, y0 as i32, h)?;
+            buf.clear(&state.range);
+            counter.start();
+            let res = tris(&mut |v, rr| {
+                if rr.0 <= b1 && rr.1 >= b0 {
+                    *stats += r.draw_format(&mut band, Some(&mut buf), v)?;
+                }
+                Ok(())
+            });
+            instructions += counter.stop();
+            res?;
+            let rb = w * F::BYTES;
+            let bytes: &[u8] = bytemuck::cast_slice(&*depth);
+            for row in 0..h as usize {
+                hash.words(&band.px[row * w..(row + 1) * w]);
+                hash.bytes(&bytes[row * rb..(row + 1) * rb]);
+            }
+        }
+        bands += 1;
+        y0 += h;
+    }
+    Ok((instructions, bands))
+}
+
+/// Renders the scene of `plan` as it says: its format (or none), strategy `R`, depth range and band rows; W4's
+/// torus is transformed by the mesh path each frame and its triangles drawn from the transformed vertices (the
+/// mesh path's own draw takes a W16 buffer only). `depth` must hold the plan's bands (`PlanData::depth_ram` bytes)
+/// and `color` at least one colour band.
+pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
+    plan: &PlanData,
+    color: &mut [u16],
+    depth: &mut [u16],
+    verts: &mut [Projected],
+    counter: &mut C,
+) -> Result<Run, Error> {
+    let mut stats = Stats::default();
+    let mut hash = Fnv::default();
+    if plan.scene == "torus" {
+        use wraster::scenes::torus;
+        let cam = torus::camera()?;
+        let mut state = cam.render_state()?;
+        state.range = wraster::DepthRange::new(plan.near, plan.far)?;
+        let mut r = Rasterizer::<R>::new(state);
+        let mesh = Mesh {
+            positions: &TORUS_POSITIONS,
+            indices: &TORUS_INDICES,
+            colors: Colors::PerFace(&TORUS_COLORS),
+        };
+        let vp = Viewport::new(0.0, 0.0, WIDTH as f32, HEIGHT as f32);
+        let (mut instructions, mut bands) = (0, 0);
+        for k in 0..torus::FRAMES {
+            let m = cam.model_matrix(&torus::model(k));
+            counter.start();
+            let frame = r.transform_mesh(&mesh, &m, &vp, verts);
+            instructions += counter.stop();
+            let frame = frame?;
+            let (i, b) = if KIND == LEAN_W16 {
+                // W16: the mesh path itself (binning by rows, its own cull), as `run_torus` draws.
+                let mut bands = 0;
+                let mut instructions = 0;
+                let w = WIDTH as usize;
+                let mut y0 = 0u16;
+                while y0 < HEIGHT {
+                    let h = plan.band_rows.min(HEIGHT - y0);
+                    let n = w * h as usize;
+                    let (color, depth) = (&mut color[..n], &mut depth[..n]);
+                    color.fill(0);
+                    let mut buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+                    buf.clear();
+                    let mut band = Band::new(color, y0 as i32);
+                    counter.start();
+                    let s = r.draw_mesh_frame(&mut band, &mut buf, &frame);
+                    instructions += counter.stop();
+                    stats += s?;
+                    for row in 0..h as usize {
+                        hash.words(&band.px[row * w..(row + 1) * w]);
+                        hash.words(&buf.data()[row * w..(row + 1) * w]);
+                    }
+                    bands += 1;
+                    y0 += h;
+                }
+                (instructions, bands)
+            } else {
+                let v = frame.vertices();
+                run_planned_tris::<F, R, C, KIND>(
+                    &mut |draw| {
+                        for (t, c) in TORUS_INDICES.iter().zip(TORUS_COLORS.iter()) {
+                            let q = t.map(|i| v[i as usize]);
+                            if q.iter().any(|p| p.rhw.is_nan() || p.rhw <= 0.0) {
+                                // Needs the clipper: the planner refuses such meshes.
+                                return Err(Error::NonFinite);
+                            }
+                            let tri = q.map(|p| Vertex {
+                                x: p.x,
+                                y: p.y,
+                                z: 0.0,
+                                rhw: p.rhw,
+                                color: *c,
+                            });
+                            let rows = wraster::row_range(&tri).unwrap_or((i32::MAX, i32::MIN));
+                            draw(&tri, rows)?;
+                        }
+                        Ok(())
+                    },
+                    plan,
+                    state,
+                    color,
+                    depth,
+                    counter,
+                    &mut stats,
+                    &mut hash,
+                )?
+            };
+            instructions += i;
+            bands = b;
+        }
+        return Ok(Run {
+            scene: "torus",
+            recip: R::NAME,
+            stats,
+            bands,
+            triangles: (torus::TRIANGLES * torus::FRAMES) as u32,
+            instructions,
+            hash: hash.0,
+        });
+    }
+    let scene = SCENES
+        .iter()
+        .find(|s| s.name == plan.scene)
+        .ok_or(Error::IndexOutOfRange)?;
+    let mut state = RenderState::new(scene.near, scene.far)?;
+    state.range = wraster::DepthRange::new(plan.near, plan.far)?;
+    let (instructions, bands) = run_planned_tris::<F, R, C, KIND>(
+        &mut |draw| {
+            for t in scene.tris {
+                draw(&t.vertices(), t.rows)?;
+            }
+            Ok(())
+        },
+        plan,
+        state,
+        color,
+        depth,
+        counter,
+        &mut stats,
+        &mut hash,
+    )?;
+    Ok(Run {
+        scene: scene.name,
+        recip: R::NAME,
+        stats,
+        bands,
+        triangles: scene.tris.len() as u32,
+        instructions,
+        hash: hash.0,
+    })
+}
+
+/// [`run_plan`] and its `bench` line, with `format=` the plan's and the added keys `plan=1 depth_ram=..
+/// visibility_errors=..` (and `frames=8 instr_per_frame=` for the torus), or an `error` line; `false` on an error.
+#[allow(clippy::too_many_arguments)]
+pub fn run_plan_line<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
+    board: &str,
+    core: &str,
+    plan: &PlanData,
+    color: &mut [u16],
+    depth: &mut [u16],
+    verts: &mut [Projected],
+    counter: &mut C,
+    mut print: impl FnMut(core::fmt::Arguments<'_>),
+) -> bool {
+    match run_plan::<F, R, C, KIND>(plan, color, depth, verts, counter) {
+        Ok(run) => {
+            let mut line = bench_line_of(board, core, &run, plan.format);
+            let _ = write!(
+                line,
+                " plan=1 depth_ram={} visibility_errors={}",
+                plan.depth_ram, plan.visibility_errors
+            );
+            if plan.scene == "torus" {
+                let frames = wraster::scenes::torus::FRAMES as u64;
+                let _ = write!(
+                    line,
+                    " frames={frames} instr_per_frame={}",
+                    Ratio(run.instructions, frames)
+                );
+            }
+            print(format_args!("{line}"));
+            true
+        }
+        Err(e) => {
+            print(format_args!(
+                "error board={board} scene={} plan {e}",
+                plan.scene
+            ));
+            false
+        }
+    }
 }
 
 /// Runs every standard scene (or only the one named by the build-time environment variable `ONLY`, for profiles:
@@ -434,11 +751,16 @@ impl core::fmt::Display for Ratio {
 
 /// The bench line of a run (the format; keys are stable).
 pub fn bench_line(board: &str, core: &str, run: &Run) -> heapless::String<360> {
+    bench_line_of(board, core, run, "W16")
+}
+
+/// [`bench_line`] with the depth format's name.
+fn bench_line_of(board: &str, core: &str, run: &Run, format: &str) -> heapless::String<360> {
     let mut s = heapless::String::new();
     let (px, fr) = (run.stats.written as u64, run.stats.fragments as u64);
     let _ = write!(
         s,
-        "bench board={board} core={core} scene={} format=W16 bands={} pixels={px} fragments={fr} triangles={} instructions={} instr_per_px={} instr_per_fragment={} instr_per_tri={} hash={:016x} recip={}",
+        "bench board={board} core={core} scene={} format={format} bands={} pixels={px} fragments={fr} triangles={} instructions={} instr_per_px={} instr_per_fragment={} instr_per_tri={} hash={:016x} recip={}",
         run.scene,
         run.bands,
         run.triangles,

@@ -11,6 +11,8 @@
 //! These are instructions, not cycles: QEMU is not cycle-accurate.
 #![no_std]
 #![no_main]
+// A plan build runs only its plans: the scene runners stay compiled but unused.
+#![cfg_attr(feature = "plan", allow(dead_code, unused_imports))]
 
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
@@ -18,7 +20,7 @@ use panic_semihosting as _;
 use wraster::recip::Fast;
 #[cfg(not(feature = "torus"))]
 use wraster::recip::SpanRecip;
-#[cfg(not(feature = "size-probe"))]
+#[cfg(not(any(feature = "size-probe", feature = "plan")))]
 use wraster::recip::{Exact, FastDiv, PrevPixel};
 #[cfg(not(feature = "torus"))]
 use wraster_board::run_all;
@@ -73,7 +75,7 @@ fn band_overhead(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) ->
 }
 
 /// `--features torus`: W4 only (the rotating torus through the mesh path), with each strategy.
-#[cfg(feature = "torus")]
+#[cfg(all(feature = "torus", not(feature = "plan")))]
 #[entry]
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];
@@ -118,7 +120,7 @@ fn main() -> ! {
     }
 }
 
-#[cfg(not(feature = "torus"))]
+#[cfg(not(any(feature = "torus", feature = "plan")))]
 #[entry]
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];
@@ -135,6 +137,63 @@ fn main() -> ! {
         & all::<Exact>(COLOR, DEPTH, &mut counter)
         & all::<PrevPixel>(COLOR, DEPTH, &mut counter)
         & band_overhead(COLOR, DEPTH, &mut counter);
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// `--features plan` (with `PLAN=<plan files>`): the planner's plans, each with only what it chose; the buffers are
+/// sized from the plans (colour bands as tall as the tallest depth band, 8 rows when no plan keeps depth; the torus's
+/// vertex store only when a plan draws it).
+#[cfg(feature = "plan")]
+mod plan_buffers {
+    use wraster_board::{plans, WIDTH};
+    const ROWS: usize = if plans::MAX_BAND_ROWS == 0 {
+        8
+    } else {
+        plans::MAX_BAND_ROWS
+    };
+    pub const COLOR_LEN: usize = WIDTH as usize * ROWS;
+    pub const DEPTH_LEN: usize = plans::MAX_DEPTH_RAM.div_ceil(2);
+    pub const VERTS_LEN: usize = if plans::HAS_TORUS {
+        wraster::scenes::torus::VERTICES
+    } else {
+        0
+    };
+    const _: () = assert!(
+        plans::COUNT > 0,
+        "--features plan needs PLAN=<file>,... (host-tests' plan binary writes them)"
+    );
+}
+#[cfg(feature = "plan")]
+use {plan_buffers::*, wraster::mesh::Projected, wraster_board::plans};
+
+#[cfg(feature = "plan")]
+#[entry]
+fn main() -> ! {
+    static mut COLOR: [u16; COLOR_LEN] = [0; COLOR_LEN];
+    static mut DEPTH: [u16; DEPTH_LEN] = [0; DEPTH_LEN];
+    static mut VERTS: [Projected; VERTS_LEN] = [Projected {
+        x: 0.0,
+        y: 0.0,
+        rhw: 0.0,
+    }; VERTS_LEN];
+    let cp = cortex_m::Peripherals::take().unwrap();
+    let mut counter = SysTick::new(cp.SYST, 125, 2);
+    let ok = plans::run_all_plans(
+        "qemu-m0",
+        "m0",
+        COLOR,
+        DEPTH,
+        VERTS,
+        &mut counter,
+        &mut |a| hprintln!("{}", a),
+    );
     debug::exit(if ok {
         debug::EXIT_SUCCESS
     } else {

@@ -62,6 +62,29 @@ fn main() -> ! {
     }; VERTICES];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 40, 1);
+    // `--features plan` (with `PLAN=<plan files>`) runs the planner's plans instead: each with only what it chose.
+    #[cfg(feature = "plan")]
+    {
+        use wraster_board::plans;
+        const _: () = assert!(
+            plans::COUNT > 0 && plans::MAX_DEPTH_RAM <= PIXELS * 2,
+            "--features plan needs PLAN=<file>,... (host-tests' plan binary writes them) within a W16 frame of RAM"
+        );
+        let ok = plans::run_all_plans(
+            "qemu-m4",
+            "m4",
+            COLOR,
+            DEPTH,
+            VERTS,
+            &mut counter,
+            &mut |a| hprintln!("{}", a),
+        );
+        debug::exit(if ok {
+            debug::EXIT_SUCCESS
+        } else {
+            debug::EXIT_FAILURE
+        });
+    }
     // This core's default: the fast tier seeded by its divide instruction.
     let ok = all::<FastDiv>(COLOR, DEPTH, VERTS, &mut counter);
     // `--features size-probe` links the default path only, to measure the library's share of .text (README).

@@ -1,0 +1,777 @@
+//! The scene planner: what a given scene needs, measured against the f64 reference, and the cheapest build that
+//! draws it with at most a given number of visibility errors (`cargo run --release -p host-tests --bin plan`).
+//!
+//! A **visibility error** is a pixel whose visible surface differs from the reference's: the reference covers it and
+//! the candidate shows nothing, or shows a triangle the reference does not cover there, or shows one whose exact
+//! depth at that pixel is farther than the nearest surface's (two surfaces at exactly the same depth are a tie:
+//! either is right). Triangles are told apart by drawing each with its own colour (its index plus one as a raw
+//! RGB565 value). The reference is [`crate::reference_tri`]: the shared coverage rules on the snapped vertices, depth
+//! from the vertices as given, in f64, with the scene's own depth range.
+//!
+//! The candidates, cheapest first:
+//! - **no depth buffer**: culling and drawing order alone (`draw_format` with no buffer);
+//! - the 16-bit formats (2 bytes a pixel): W16 through the lean path (`Rasterizer::draw`, the fast tier), then
+//!   LZ16, Z16 and W16F through `draw_format`; then the 24-bit (W24F, W24FScaled, Z24) and 32-bit (W32F, Z32F,
+//!   RZ32F) ones;
+//! - for each format the W strategies in the order of their measured cost on the core (the boards' `bench` lines in
+//!   the README: on the M4 and RV32 `fast-div`, `fast`, `exact`, `prev-pixel`; on the M0, whose division is a
+//!   library call, `fast` first);
+//! - for each, the depth range tightened to the W the scene really draws (the smallest and largest reference W over
+//!   its covered pixels and frames, widened by `2^-8` of itself so that no pixel the scene draws falls outside),
+//!   then the scene's own.
+//!
+//! The first candidate within the budget is the plan: every candidate is measured by rendering, so a plan's stated
+//! error count is what its build draws. The band height is the most rows whose depth buffer fits the RAM budget.
+use std::fmt::Write as _;
+
+use embedded_graphics::pixelcolor::raw::RawU16;
+use embedded_graphics::pixelcolor::Rgb565;
+use embedded_graphics::prelude::*;
+use wraster::format::{
+    DepthFormat, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F,
+};
+use wraster::recip::{Exact, Fast, FastDiv, PrevPixel, SpanRecip};
+use wraster::{Codec, Cull, Error, Packed, Rasterizer, RenderState, Vertex};
+
+use crate::{in_bands, reference_tri, snap, Frame};
+
+/// A core the plan is for: it orders the strategies by their cost there and sets the default depth RAM.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Core {
+    /// Cortex-M0/M0+ (no divide instruction).
+    M0,
+    /// Cortex-M4F.
+    M4,
+    /// RV32IMAC.
+    Rv32,
+}
+
+impl Core {
+    /// From `m0`, `m4` or `rv32`.
+    pub fn parse(s: &str) -> Option<Core> {
+        match s {
+            "m0" => Some(Core::M0),
+            "m4" => Some(Core::M4),
+            "rv32" => Some(Core::Rv32),
+            _ => None,
+        }
+    }
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Core::M0 => "m0",
+            Core::M4 => "m4",
+            Core::Rv32 => "rv32",
+        }
+    }
+    /// The W strategies, cheapest first on this core (the README's measured `bench` figures: every scene and W4).
+    pub fn strategies(self) -> [&'static str; 4] {
+        match self {
+            Core::M0 => ["fast", "fast-div", "exact", "prev-pixel"],
+            Core::M4 | Core::Rv32 => ["fast-div", "fast", "exact", "prev-pixel"],
+        }
+    }
+    /// The depth RAM the boards give scene `scene`: the M0 board's 16 KiB holds 8-row W16 bands (5,120 bytes)
+    /// beside its colour band, 4-row ones (2,560) for the torus, whose 512 transformed vertices take 6 KiB; the M4
+    /// and RV32 boards hold a whole W16 frame (153,600 bytes).
+    pub fn default_depth_ram(self, scene: &str) -> usize {
+        match self {
+            Core::M0 if scene == "torus" => 320 * 4 * 2,
+            Core::M0 => 320 * 8 * 2,
+            Core::M4 | Core::Rv32 => 320 * 240 * 2,
+        }
+    }
+}
+
+/// The depth formats a plan may choose, cheapest first ("none": no depth buffer).
+pub const FORMATS: [&str; 11] = [
+    "none",
+    "W16",
+    "LZ16",
+    "Z16",
+    "W16F",
+    "W24F",
+    "W24FScaled",
+    "Z24",
+    "W32F",
+    "Z32F",
+    "RZ32F",
+];
+
+/// Bytes a pixel of format `name` stores.
+pub fn format_bytes(name: &str) -> usize {
+    match name {
+        "none" => 0,
+        "W16" => W16::BYTES,
+        "LZ16" => LZ16::BYTES,
+        "Z16" => Z16::BYTES,
+        "W16F" => W16F::BYTES,
+        "W24F" => W24F::BYTES,
+        "W24FScaled" => W24FScaled::BYTES,
+        "Z24" => Z24::BYTES,
+        "W32F" => W32F::BYTES,
+        "Z32F" => Z32F::BYTES,
+        "RZ32F" => RZ32F::BYTES,
+        _ => panic!("unknown format {name}"),
+    }
+}
+
+/// A scene to plan: its frames (each a list of screen-space triangles in drawing order), the render state it is
+/// drawn with (depth range, compare, culling) and the frame size.
+pub struct Workload {
+    /// Its name (`big`, `overdraw`, `small`, `terrain`, `torus`).
+    pub name: String,
+    /// The triangles of each frame, in drawing order.
+    pub frames: Vec<Vec<[Vertex<Rgb565>; 3]>>,
+    /// The scene's own render state.
+    pub state: RenderState,
+    /// Frame width.
+    pub w: u16,
+    /// Frame height.
+    pub h: u16,
+}
+
+/// The workload of a standard scene or of W4 (`torus`: its 8 frames through the core's f32 transform, as the
+/// boards draw them; the screen-space vertices are the same for every candidate, so its visibility errors count
+/// depth decisions only).
+pub fn workload(name: &str) -> Result<Workload, String> {
+    use wraster::scenes::{torus, Scene, HEIGHT, WIDTH};
+    if let Some(scene) = Scene::ALL.into_iter().find(|s| s.name() == name) {
+        let (near, far) = scene.depth_range();
+        return Ok(Workload {
+            name: name.into(),
+            frames: vec![scene.tris().collect()],
+            state: RenderState::new(near, far).map_err(|e| format!("{e:?}"))?,
+            w: WIDTH,
+            h: HEIGHT,
+        });
+    }
+    if name != "torus" {
+        return Err(format!(
+            "unknown scene {name:?} (big, overdraw, small, terrain, torus)"
+        ));
+    }
+    let cam = torus::camera().map_err(|e| format!("{e:?}"))?;
+    let (pos, idx) = (torus::positions(), torus::indices());
+    let state = cam.render_state().map_err(|e| format!("{e:?}"))?;
+    let frames = (0..torus::FRAMES)
+        .map(|k| {
+            screen_tris(
+                &pos,
+                &idx,
+                &cam.model_matrix(&torus::model(k)),
+                state,
+                WIDTH,
+                HEIGHT,
+            )
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(Workload {
+        name: name.into(),
+        frames,
+        state,
+        w: WIDTH,
+        h: HEIGHT,
+    })
+}
+
+/// A mesh's triangles in screen space through the core's own transform (`transform_mesh`), every face, in index
+/// order (culling is the render state's, in the draw). A triangle with a vertex outside the view volume would need
+/// the clipper, which a plan does not model yet: an error.
+pub fn screen_tris(
+    pos: &[[f32; 3]],
+    idx: &[[u16; 3]],
+    m: &wraster::projection::Mat4,
+    state: RenderState,
+    w: u16,
+    h: u16,
+) -> Result<Vec<[Vertex<Rgb565>; 3]>, String> {
+    use wraster::clip::Viewport;
+    use wraster::mesh::{Colors, Mesh, Projected};
+    let mesh = Mesh {
+        positions: pos,
+        indices: idx,
+        colors: Colors::Uniform(Rgb565::WHITE),
+    };
+    let mut scratch = vec![Projected::default(); pos.len()];
+    let r = Rasterizer::<Fast>::new(state);
+    let vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
+    let mf = r
+        .transform_mesh(&mesh, m, &vp, &mut scratch)
+        .map_err(|e| format!("{e:?}"))?;
+    let v = mf.vertices();
+    idx.iter()
+        .map(|t| {
+            let q = t.map(|i| v[i as usize]);
+            if q.iter().any(|p| p.rhw.is_nan() || p.rhw <= 0.0) {
+                return Err(
+                    "a triangle crosses the view volume: planning clipped meshes is not built yet"
+                        .into(),
+                );
+            }
+            Ok(q.map(|p| Vertex {
+                x: p.x,
+                y: p.y,
+                z: 0.0,
+                rhw: p.rhw,
+                color: Rgb565::WHITE,
+            }))
+        })
+        .collect()
+}
+
+/// Triangle `k`'s colour in an id frame.
+fn id_color(k: usize) -> Rgb565 {
+    RawU16::new(k as u16 + 1).into()
+}
+
+/// What the reference says of every pixel of one frame: the covering triangles (id, exact `W / W_far` of the
+/// scene's range) in range.
+pub struct Reference {
+    per_px: Vec<Vec<(u32, f64)>>,
+}
+
+impl Reference {
+    /// The reference of `tris` drawn with `state`'s depth range and culling in a `w x h` frame.
+    pub fn new(tris: &[[Vertex<Rgb565>; 3]], state: &RenderState, w: u16, h: u16) -> Reference {
+        let (near, far) = (state.range.near(), state.range.far());
+        let mut per_px = vec![Vec::new(); w as usize * h as usize];
+        for (k, t) in tris.iter().enumerate() {
+            // The shared culling rule, on the snapped vertices: the doubled signed area (y down).
+            let p = t.map(|q| (snap(q.x), snap(q.y)));
+            let area =
+                (p[1].0 - p[0].0) * (p[2].1 - p[0].1) - (p[2].0 - p[0].0) * (p[1].1 - p[0].1);
+            let culled = match state.cull {
+                Cull::Cw => area > 0,
+                Cull::Ccw => area < 0,
+                Cull::None => false,
+            };
+            if culled {
+                continue;
+            }
+            let v = t.map(|q| (q.x, q.y, q.rhw));
+            for px in reference_tri(&v, near, far, w as i32, 0..h as i32).unwrap_or_default() {
+                if px.in_range {
+                    per_px[(px.y as usize) * w as usize + px.x as usize]
+                        .push((k as u32, 1.0 / px.t));
+                }
+            }
+        }
+        Reference { per_px }
+    }
+
+    /// The smallest and largest `W / W_far` of a covered pixel (`None` when nothing is covered).
+    pub fn depth_span(&self) -> Option<(f64, f64)> {
+        let mut it = self.per_px.iter().flatten().map(|&(_, d)| d);
+        let first = it.next()?;
+        Some(it.fold((first, first), |(a, b), d| (a.min(d), b.max(d))))
+    }
+
+    /// The visibility errors of an id frame (each pixel: 0 for nothing, else the triangle's index plus one).
+    pub fn errors(&self, ids: &[u32]) -> u32 {
+        let mut n = 0;
+        for (list, &id) in self.per_px.iter().zip(ids) {
+            let nearest = list.iter().map(|&(_, d)| d).fold(f64::INFINITY, f64::min);
+            let ok = if id == 0 {
+                list.is_empty()
+            } else {
+                list.iter().any(|&(k, d)| k + 1 == id && d <= nearest)
+            };
+            n += u32::from(!ok);
+        }
+        n
+    }
+
+    /// The smallest gap between the nearest and the second-nearest surface at a pixel, in steps of format `F` at the
+    /// nearest surface's depth (`F::step`), with depth range `[near, far]` (`f64::INFINITY` when no pixel has two).
+    pub fn min_gap_steps<F: DepthFormat>(&self, far_of_ref: f64, near: f64, far: f64) -> f64 {
+        let mut best = f64::INFINITY;
+        for list in &self.per_px {
+            if list.len() < 2 {
+                continue;
+            }
+            let mut d: Vec<f64> = list.iter().map(|&(_, d)| d * far_of_ref).collect();
+            d.sort_by(f64::total_cmp);
+            if d[1] > d[0] {
+                best = best.min((d[1] - d[0]) / F::step(d[0], near, far));
+            }
+        }
+        best
+    }
+}
+
+/// Renders `tris` (each in its id colour) with format `format` (or none), strategy `strategy` and `state`, in bands
+/// of `band_h` rows: the id frame.
+pub fn render_ids(
+    tris: &[[Vertex<Rgb565>; 3]],
+    format: &str,
+    strategy: &str,
+    state: RenderState,
+    w: u16,
+    h: u16,
+    band_h: u16,
+) -> Result<Vec<u32>, Error> {
+    let tris: Vec<_> = tris
+        .iter()
+        .enumerate()
+        .map(|(k, t)| {
+            t.map(|mut v| {
+                v.color = id_color(k);
+                v
+            })
+        })
+        .collect();
+    let frame = match strategy {
+        "fast" => draw_as::<Fast>(&tris, format, state, w, h, band_h)?,
+        "fast-div" => draw_as::<FastDiv>(&tris, format, state, w, h, band_h)?,
+        "exact" => draw_as::<Exact>(&tris, format, state, w, h, band_h)?,
+        "prev-pixel" => draw_as::<PrevPixel>(&tris, format, state, w, h, band_h)?,
+        _ => panic!("unknown strategy {strategy}"),
+    };
+    Ok(frame.px.iter().map(|c| c.into_storage() as u32).collect())
+}
+
+fn draw_as<R: SpanRecip>(
+    tris: &[[Vertex<Rgb565>; 3]],
+    format: &str,
+    state: RenderState,
+    w: u16,
+    h: u16,
+    band_h: u16,
+) -> Result<Frame, Error> {
+    match format {
+        "none" => {
+            let mut frame = Frame::new(w as u32, h as u32);
+            let mut r = Rasterizer::<R>::new(state);
+            for t in tris {
+                r.draw_format::<W16, _>(&mut frame, None, t)?;
+            }
+            Ok(frame)
+        }
+        "W16" => {
+            let mut frame = Frame::new(w as u32, h as u32);
+            let mut depth = vec![0u16; w as usize * h as usize];
+            let mut r = Rasterizer::<R>::new(state);
+            in_bands(&mut depth, w, h, band_h, |buf| {
+                let mut s = wraster::Stats::default();
+                for t in tris {
+                    s += r.draw(&mut frame, buf, t)?;
+                }
+                Ok(s)
+            })?;
+            Ok(frame)
+        }
+        "LZ16" => packed::<LZ16, R>(tris, state, w, h, band_h),
+        "Z16" => packed::<Z16, R>(tris, state, w, h, band_h),
+        "W16F" => packed::<W16F, R>(tris, state, w, h, band_h),
+        "W24F" => packed::<W24F, R>(tris, state, w, h, band_h),
+        "W24FScaled" => packed::<W24FScaled, R>(tris, state, w, h, band_h),
+        "Z24" => packed::<Z24, R>(tris, state, w, h, band_h),
+        "W32F" => packed::<W32F, R>(tris, state, w, h, band_h),
+        "Z32F" => packed::<Z32F, R>(tris, state, w, h, band_h),
+        "RZ32F" => packed::<RZ32F, R>(tris, state, w, h, band_h),
+        _ => panic!("unknown format {format}"),
+    }
+}
+
+/// A packed format's draw in bands of `band_h` rows, each cleared to the far plane first.
+fn packed<F: Codec, R: SpanRecip>(
+    tris: &[[Vertex<Rgb565>; 3]],
+    state: RenderState,
+    w: u16,
+    h: u16,
+    band_h: u16,
+) -> Result<Frame, Error> {
+    let mut frame = Frame::new(w as u32, h as u32);
+    let mut r = Rasterizer::<R>::new(state);
+    let mut bytes = vec![0u8; w as usize * band_h as usize * F::BYTES];
+    let mut y0 = 0u16;
+    while y0 < h {
+        let bh = band_h.min(h - y0);
+        let mut buf = Packed::<F>::band(
+            &mut bytes[..w as usize * bh as usize * F::BYTES],
+            w,
+            y0 as i32,
+            bh,
+        )?;
+        buf.clear(&state.range);
+        for t in tris {
+            r.draw_format(&mut frame, Some(&mut buf), t)?;
+        }
+        y0 += bh;
+    }
+    Ok(frame)
+}
+
+/// What the planner is asked for.
+#[derive(Clone, Copy, Debug)]
+pub struct Budget {
+    /// The most visibility errors allowed, over every frame.
+    pub max_visibility_errors: u32,
+    /// Bytes the depth buffer may take.
+    pub depth_ram: usize,
+    /// The core.
+    pub core: Core,
+}
+
+/// A plan: what to build for a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plan {
+    /// The scene.
+    pub scene: String,
+    /// The core it is for.
+    pub core: Core,
+    /// The depth format (`none`: no depth buffer).
+    pub format: String,
+    /// The W strategy.
+    pub strategy: String,
+    /// `W_near` of the plan's render state.
+    pub near: f32,
+    /// `W_far`.
+    pub far: f32,
+    /// Rows per band (the frame's height: one band).
+    pub band_rows: u16,
+    /// Bands per frame.
+    pub bands: u16,
+    /// Bytes of depth buffer.
+    pub depth_ram: usize,
+    /// The crate features the scene needs (none of the standard scenes uses Gouraud colour, depth bias or lighting).
+    pub features: Vec<&'static str>,
+    /// Visibility errors over every frame, measured.
+    pub visibility_errors: u32,
+    /// Candidates measured before this one was taken: `(format, strategy, range, errors)`.
+    pub tried: Vec<(String, String, &'static str, u32)>,
+    /// Whether the plan meets the error budget (when no candidate does, the plan is the cheapest of those with the
+    /// fewest errors: a scene whose surfaces intersect has pixels where they are closer than any format's step).
+    pub budget_met: bool,
+}
+
+impl Plan {
+    /// The line scripts read.
+    pub fn line(&self) -> String {
+        let features = if self.features.is_empty() {
+            "none".to_string()
+        } else {
+            self.features.join(",")
+        };
+        format!(
+            "plan scene={} format={} strategy={} near={} far={} bands={} depth_ram={} features={} visibility_errors={} core={} band_rows={} budget_met={}",
+            self.scene,
+            self.format,
+            self.strategy,
+            self.near,
+            self.far,
+            self.bands,
+            self.depth_ram,
+            features,
+            self.visibility_errors,
+            self.core.name(),
+            self.band_rows,
+            self.budget_met
+        )
+    }
+
+    /// The plan as Rust source, for a board's build.rs to include (`PLAN=<file>,...`; see boards/common): the
+    /// chosen format and strategy as type aliases, the depth path as a constant, the rest as a `PlanData`, so the
+    /// firmware names only what the plan chose.
+    pub fn rust(&self, command: &str) -> String {
+        let strategy = match self.strategy.as_str() {
+            "fast" => "Fast",
+            "fast-div" => "FastDiv",
+            "exact" => "Exact",
+            "prev-pixel" => "PrevPixel",
+            s => panic!("unknown strategy {s}"),
+        };
+        let (format, kind) = match self.format.as_str() {
+            "none" => ("W16", "NO_DEPTH"),
+            "W16" => ("W16", "LEAN_W16"),
+            f => (f, "PACKED"),
+        };
+        let mut s = String::new();
+        writeln!(
+            s,
+            "// The plan for scene `{}` on {}, written by `{command}`: generated, do not edit.",
+            self.scene,
+            self.core.name()
+        )
+        .unwrap();
+        writeln!(s, "// {}", self.line()).unwrap();
+        writeln!(s, "/// Its depth format (with `NO_DEPTH`, only named).\npub type PlanFormat = wraster::format::{format};").unwrap();
+        writeln!(
+            s,
+            "/// Its W strategy.\npub type PlanStrategy = wraster::recip::{strategy};"
+        )
+        .unwrap();
+        writeln!(
+            s,
+            "/// Its depth path.\npub const PLAN_KIND: u8 = crate::{kind};"
+        )
+        .unwrap();
+        writeln!(
+            s,
+            "/// The plan.\npub const PLAN: crate::PlanData = crate::PlanData {{ scene: {:?}, format: {:?}, near: f32::from_bits({:#010x}), far: f32::from_bits({:#010x}), band_rows: {}, depth_ram: {}, visibility_errors: {} }};",
+            self.scene, self.format, self.near.to_bits(), self.far.to_bits(), self.band_rows, self.depth_ram, self.visibility_errors
+        )
+        .unwrap();
+        s
+    }
+}
+
+/// The depth range `[near, far]` tightened to the W a scene draws (`span`: the smallest and largest `W / W_far` of
+/// its covered pixels), widened by `2^-8` of itself, never beyond the scene's own range.
+pub fn tightened(state: &RenderState, span: (f64, f64)) -> (f32, f32) {
+    let (n, f) = (state.range.near(), state.range.far());
+    let lo = (span.0 * f as f64 * (1.0 - 1.0 / 256.0)) as f32;
+    let hi = (span.1 * f as f64 * (1.0 + 1.0 / 256.0)) as f32;
+    (lo.max(n), hi.min(f))
+}
+
+/// The visibility errors of one candidate over every frame of `wl`.
+pub fn errors_of(
+    wl: &Workload,
+    refs: &[Reference],
+    format: &str,
+    strategy: &str,
+    state: RenderState,
+    band_rows: u16,
+) -> Result<u32, Error> {
+    let mut n = 0;
+    for (tris, r) in wl.frames.iter().zip(refs) {
+        n += r.errors(&render_ids(
+            tris, format, strategy, state, wl.w, wl.h, band_rows,
+        )?);
+    }
+    Ok(n)
+}
+
+/// The cheapest plan within `budget` (see the module's docs); when no candidate meets it, the cheapest of those
+/// with the fewest errors, with `budget_met: false` (with too little depth RAM for any format, that is "none").
+pub fn plan(wl: &Workload, budget: Budget) -> Result<Plan, Error> {
+    let refs: Vec<Reference> = wl
+        .frames
+        .iter()
+        .map(|t| Reference::new(t, &wl.state, wl.w, wl.h))
+        .collect();
+    let span = refs
+        .iter()
+        .filter_map(Reference::depth_span)
+        .fold(None, |acc: Option<(f64, f64)>, (a, b)| {
+            Some(acc.map_or((a, b), |(x, y)| (x.min(a), y.max(b))))
+        });
+    let own = (wl.state.range.near(), wl.state.range.far());
+    let mut ranges = vec![];
+    if let Some(s) = span {
+        let t = tightened(&wl.state, s);
+        if t.0 < t.1 && t != own {
+            ranges.push(("tight", t));
+        }
+    }
+    ranges.push(("scene", own));
+    let mut tried = vec![];
+    let mut best: Option<Plan> = None;
+    for format in FORMATS {
+        let bytes = format_bytes(format);
+        let row_bytes = wl.w as usize * bytes;
+        let band_rows = if bytes == 0 {
+            wl.h
+        } else {
+            (budget.depth_ram / row_bytes).min(wl.h as usize) as u16
+        };
+        if band_rows == 0 {
+            continue;
+        }
+        let bands = wl.h.div_ceil(band_rows);
+        let strategies: Vec<&str> = if bytes == 0 {
+            vec![budget.core.strategies()[0]]
+        } else {
+            budget.core.strategies().to_vec()
+        };
+        for strategy in strategies {
+            for &(kind, (near, far)) in &ranges {
+                if bytes == 0 && kind == "tight" {
+                    // Without a depth buffer the range only culls: keep the scene's.
+                    continue;
+                }
+                let mut state = wl.state;
+                state.range = wraster::DepthRange::new(near, far)?;
+                let e = errors_of(wl, &refs, format, strategy, state, band_rows)?;
+                tried.push((format.to_string(), strategy.to_string(), kind, e));
+                let p = Plan {
+                    scene: wl.name.clone(),
+                    core: budget.core,
+                    format: format.into(),
+                    strategy: strategy.into(),
+                    near,
+                    far,
+                    band_rows,
+                    bands,
+                    depth_ram: row_bytes * band_rows as usize,
+                    features: vec![],
+                    visibility_errors: e,
+                    tried: vec![],
+                    budget_met: e <= budget.max_visibility_errors,
+                };
+                if p.budget_met {
+                    return Ok(Plan { tried, ..p });
+                }
+                if best.as_ref().is_none_or(|b| e < b.visibility_errors) {
+                    best = Some(p);
+                }
+            }
+        }
+    }
+    let best = best.ok_or(Error::BufferSize {
+        expected: wl.w as usize * 2,
+        actual: budget.depth_ram,
+    })?;
+    Ok(Plan { tried, ..best })
+}
+
+/// FNV-1a 64 over bytes (the boards' `Fnv`).
+fn fnv(h: &mut u64, bytes: &[u8]) {
+    for &b in bytes {
+        *h ^= b as u64;
+        *h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+}
+
+/// What a board built from `plan` prints for it (`hash`, `pixels`, `fragments`), computed here: the plan's scene in
+/// its own colours, drawn as the board draws it (its format or none, strategy, range, bands; the torus's W16
+/// frames through the mesh path), hashed as the boards hash: each row's RGB565 colours, then its stored depth
+/// bytes (none without a buffer).
+pub fn plan_hash(plan: &Plan) -> Result<(u64, u32, u32), Error> {
+    match plan.strategy.as_str() {
+        "fast" => plan_hash_as::<Fast>(plan),
+        "fast-div" => plan_hash_as::<FastDiv>(plan),
+        "exact" => plan_hash_as::<Exact>(plan),
+        "prev-pixel" => plan_hash_as::<PrevPixel>(plan),
+        s => panic!("unknown strategy {s}"),
+    }
+}
+
+fn plan_hash_as<R: SpanRecip>(plan: &Plan) -> Result<(u64, u32, u32), Error> {
+    use wraster::scenes::{torus, Scene};
+    let wl = workload(&plan.scene).map_err(|_| Error::IndexOutOfRange)?;
+    let mut state = wl.state;
+    state.range = wraster::DepthRange::new(plan.near, plan.far)?;
+    let (w, h) = (wl.w as usize, wl.h as usize);
+    let mut hash = 0xcbf2_9ce4_8422_2325u64;
+    let mut stats = wraster::Stats::default();
+    let frames: Vec<Vec<[Vertex<Rgb565>; 3]>> =
+        match Scene::ALL.into_iter().find(|s| s.name() == plan.scene) {
+            Some(s) => vec![s.tris().collect()],
+            None => {
+                // The torus in its own face colours.
+                let col = torus::colors();
+                wl.frames
+                    .iter()
+                    .map(|f| {
+                        f.iter()
+                            .zip(col.iter())
+                            .map(|(t, c)| {
+                                t.map(|mut v| {
+                                    v.color = *c;
+                                    v
+                                })
+                            })
+                            .collect()
+                    })
+                    .collect()
+            }
+        };
+    for (k, tris) in frames.iter().enumerate() {
+        let mut frame = Frame::new(w as u32, h as u32);
+        let mut r = Rasterizer::<R>::new(state);
+        let depth_rows: Vec<Vec<u8>> = match plan.format.as_str() {
+            "none" => {
+                for t in tris {
+                    stats += r.draw_format::<W16, _>(&mut frame, None, t)?;
+                }
+                vec![vec![]; h]
+            }
+            "W16" => {
+                let mut depth = vec![0u16; w * h];
+                if plan.scene == "torus" {
+                    let (f, d, s) = crate::render_torus_with::<R>(k, plan.band_rows, state)?;
+                    frame = f;
+                    depth = d;
+                    stats += s;
+                } else {
+                    stats += in_bands(&mut depth, wl.w, wl.h, plan.band_rows, |buf| {
+                        let mut s = wraster::Stats::default();
+                        for t in tris {
+                            s += r.draw(&mut frame, buf, t)?;
+                        }
+                        Ok(s)
+                    })?;
+                }
+                depth
+                    .chunks(w)
+                    .map(|row| row.iter().flat_map(|c| c.to_le_bytes()).collect())
+                    .collect()
+            }
+            f => {
+                let (fr, rows, s) = packed_rows::<R>(f, tris, state, wl.w, wl.h, plan.band_rows)?;
+                frame = fr;
+                stats += s;
+                rows
+            }
+        };
+        for (y, d) in depth_rows.iter().enumerate() {
+            let row: Vec<u8> = frame.px[y * w..(y + 1) * w]
+                .iter()
+                .flat_map(|c| c.into_storage().to_le_bytes())
+                .collect();
+            fnv(&mut hash, &row);
+            fnv(&mut hash, d);
+        }
+    }
+    Ok((hash, stats.written, stats.fragments))
+}
+
+fn packed_rows<R: SpanRecip>(
+    format: &str,
+    tris: &[[Vertex<Rgb565>; 3]],
+    state: RenderState,
+    w: u16,
+    h: u16,
+    band_h: u16,
+) -> Result<(Frame, Vec<Vec<u8>>, wraster::Stats), Error> {
+    fn go<F: Codec, R: SpanRecip>(
+        tris: &[[Vertex<Rgb565>; 3]],
+        state: RenderState,
+        w: u16,
+        h: u16,
+        band_h: u16,
+    ) -> Result<(Frame, Vec<Vec<u8>>, wraster::Stats), Error> {
+        let mut frame = Frame::new(w as u32, h as u32);
+        let mut r = Rasterizer::<R>::new(state);
+        let mut rows = vec![];
+        let mut stats = wraster::Stats::default();
+        let mut y0 = 0u16;
+        while y0 < h {
+            let bh = band_h.min(h - y0);
+            let mut bytes = vec![0u8; w as usize * bh as usize * F::BYTES];
+            let mut buf = Packed::<F>::band(&mut bytes, w, y0 as i32, bh)?;
+            buf.clear(&state.range);
+            for t in tris {
+                stats += r.draw_format(&mut frame, Some(&mut buf), t)?;
+            }
+            rows.extend(bytes.chunks(w as usize * F::BYTES).map(<[u8]>::to_vec));
+            y0 += bh;
+        }
+        Ok((frame, rows, stats))
+    }
+    match format {
+        "LZ16" => go::<LZ16, R>(tris, state, w, h, band_h),
+        "Z16" => go::<Z16, R>(tris, state, w, h, band_h),
+        "W16F" => go::<W16F, R>(tris, state, w, h, band_h),
+        "W24F" => go::<W24F, R>(tris, state, w, h, band_h),
+        "W24FScaled" => go::<W24FScaled, R>(tris, state, w, h, band_h),
+        "Z24" => go::<Z24, R>(tris, state, w, h, band_h),
+        "W32F" => go::<W32F, R>(tris, state, w, h, band_h),
+        "Z32F" => go::<Z32F, R>(tris, state, w, h, band_h),
+        "RZ32F" => go::<RZ32F, R>(tris, state, w, h, band_h),
+        _ => panic!("unknown format {format}"),
+    }
+}

@@ -1,0 +1,239 @@
+//! The scene planner (`host_tests::plan`, the `plan` binary): its error count counts what it claims, its plans are
+//! what the scenes need, and the boards built from them draw the host's frames.
+
+use embedded_graphics::pixelcolor::Rgb565;
+use host_tests::plan::{
+    errors_of, plan, plan_hash, render_ids, workload, Budget, Core, Reference, Workload,
+};
+use host_tests::{have, run_board_env};
+use wraster::{RenderState, Vertex};
+
+fn budget(core: Core, scene: &str) -> Budget {
+    Budget {
+        max_visibility_errors: 0,
+        depth_ram: core.default_depth_ram(scene),
+        core,
+    }
+}
+
+/// Two overlapping triangles, the nearer drawn second; the reference's error count of an id frame.
+#[test]
+fn visibility_errors_count_what_they_claim() {
+    let c = Rgb565::new(1, 2, 3);
+    let far = [
+        Vertex::new(2.0, 2.0, 50.0, c),
+        Vertex::new(30.0, 2.0, 50.0, c),
+        Vertex::new(2.0, 30.0, 50.0, c),
+    ];
+    let near = [
+        Vertex::new(10.0, 10.0, 20.0, c),
+        Vertex::new(30.0, 10.0, 20.0, c),
+        Vertex::new(10.0, 30.0, 20.0, c),
+    ];
+    let wl = Workload {
+        name: "two".into(),
+        frames: vec![vec![far, near]],
+        state: RenderState::new(1.0, 100.0).unwrap(),
+        w: 32,
+        h: 32,
+    };
+    let r = Reference::new(&wl.frames[0], &wl.state, wl.w, wl.h);
+    // With a depth buffer: the nearer one wins everywhere it covers, 0 errors.
+    let good = render_ids(&wl.frames[0], "W16", "exact", wl.state, 32, 32, 32).unwrap();
+    assert_eq!(r.errors(&good), 0);
+    // Drawn the other way round without depth, every pixel both cover shows the far one: each is an error.
+    let swapped = render_ids(&[near, far], "none", "exact", wl.state, 32, 32, 32).unwrap();
+    // (ids of the swapped list: 1 = near, 2 = far; map back to the reference's order.)
+    let back: Vec<u32> = swapped.iter().map(|&id| [0, 2, 1][id as usize]).collect();
+    let overlap = good
+        .iter()
+        .zip(&back)
+        .filter(|&(&g, &b)| g == 2 && b == 1)
+        .count() as u32;
+    assert!(overlap > 50);
+    assert_eq!(r.errors(&back), overlap);
+    // Nothing shown where the reference covers, or something where it covers nothing: errors too.
+    let mut holes = good.clone();
+    holes[10 * 32 + 12] = 0;
+    holes[31 * 32 + 31] = 1;
+    assert_eq!(r.errors(&holes), 2);
+    // The same through errors_of: the depth-less frame in drawing order (far, then near) is right.
+    assert_eq!(
+        errors_of(&wl, &[r], "none", "fast", wl.state, 32).unwrap(),
+        0
+    );
+}
+
+/// What each standard scene and W4 needs, on each core's default budget (0 visibility errors): W1 (one triangle)
+/// and W3 (a grid of quads that never overlap) need no depth buffer, W2 and the torus need one and get W16 with the
+/// range tightened to the W they draw, and the terrain's interpenetrating boxes have pixels where two surfaces are
+/// closer than any format's step, so no candidate meets 0 and the plan is the first with the fewest errors.
+#[test]
+fn plans_fit_their_scenes() {
+    for core in [Core::M4, Core::M0] {
+        for scene in ["big", "overdraw", "small", "terrain", "torus"] {
+            let wl = workload(scene).unwrap();
+            let p = plan(&wl, budget(core, scene)).unwrap();
+            assert_eq!(
+                p.strategy,
+                core.strategies()[0],
+                "{scene}: the core's cheapest strategy"
+            );
+            let refs: Vec<Reference> = wl
+                .frames
+                .iter()
+                .map(|t| Reference::new(t, &wl.state, wl.w, wl.h))
+                .collect();
+            let mut state = wl.state;
+            state.range = wraster::DepthRange::new(p.near, p.far).unwrap();
+            // Its stated error count is what its build draws, in its bands.
+            let measured =
+                errors_of(&wl, &refs, &p.format, &p.strategy, state, p.band_rows).unwrap();
+            assert_eq!(measured, p.visibility_errors, "{scene}");
+            assert!(p.depth_ram <= core.default_depth_ram(scene), "{scene}");
+            match scene {
+                "big" | "small" => {
+                    assert_eq!(
+                        (p.format.as_str(), p.depth_ram, p.visibility_errors),
+                        ("none", 0, 0),
+                        "{scene}"
+                    );
+                }
+                "overdraw" | "torus" => {
+                    assert!(p.budget_met && p.visibility_errors == 0, "{scene}");
+                    assert_eq!(p.format, "W16", "{scene}");
+                    // The depth-less candidate was measured first, and fails: the surfaces overlap.
+                    assert_eq!(p.tried[0].0, "none");
+                    assert!(p.tried[0].3 > 1000, "{scene}: {:?}", p.tried[0]);
+                    // The range is the W drawn, within the scene's, and a pixel's W stays inside it.
+                    assert!(
+                        p.near > wl.state.range.near() && p.far < wl.state.range.far(),
+                        "{scene}"
+                    );
+                    assert_eq!(p.band_rows as usize * 320 * 2, p.depth_ram);
+                }
+                _ => {
+                    assert!(!p.budget_met && p.visibility_errors > 0);
+                    let fewest = p.tried.iter().map(|t| t.3).min().unwrap();
+                    assert_eq!(p.visibility_errors, fewest);
+                    // W16 on the terrain: its far boxes need more than 16 bits of linear W.
+                    let w16 = p.tried.iter().find(|t| t.0 == "W16").unwrap().3;
+                    assert!(w16 > p.visibility_errors);
+                }
+            }
+        }
+    }
+    // A larger budget takes a cheaper plan: W16 on the terrain.
+    let wl = workload("terrain").unwrap();
+    let w16 = plan(&wl, budget(Core::M4, "terrain"))
+        .unwrap()
+        .tried
+        .iter()
+        .find(|t| t.0 == "W16")
+        .unwrap()
+        .3;
+    let p = plan(
+        &wl,
+        Budget {
+            max_visibility_errors: w16,
+            ..budget(Core::M4, "terrain")
+        },
+    )
+    .unwrap();
+    assert!(p.budget_met && p.format == "W16" && p.visibility_errors <= w16);
+    // Less RAM, more bands; too little for one row of any format leaves only "none", which misses the budget.
+    let wl = workload("overdraw").unwrap();
+    let p = plan(
+        &wl,
+        Budget {
+            depth_ram: 320 * 2 * 10,
+            ..budget(Core::M0, "overdraw")
+        },
+    )
+    .unwrap();
+    assert_eq!((p.band_rows, p.bands, p.visibility_errors), (10, 24, 0));
+    let p = plan(
+        &wl,
+        Budget {
+            depth_ram: 100,
+            ..budget(Core::M0, "overdraw")
+        },
+    )
+    .unwrap();
+    assert!(!p.budget_met && p.format == "none" && p.visibility_errors > 1000);
+    let wl = workload("big").unwrap();
+    assert_eq!(
+        plan(
+            &wl,
+            Budget {
+                depth_ram: 0,
+                ..budget(Core::M0, "big")
+            }
+        )
+        .unwrap()
+        .format,
+        "none"
+    );
+}
+
+/// The boards built from the plans (`--features plan`, `PLAN=<files>`) print the hash, pixel and fragment counts of
+/// the host's rendering of each plan. Needs QEMU, as `firmware.rs` (`WRASTER_SKIP_FIRMWARE=1` skips knowingly).
+#[test]
+fn boards_built_from_plans_draw_the_hosts_frames() {
+    if !have("qemu-system-arm") {
+        assert!(
+            std::env::var("WRASTER_SKIP_FIRMWARE").is_ok_and(|v| v == "1"),
+            "QEMU (qemu-system-arm) is missing: install it (.ci/run shows how) or set WRASTER_SKIP_FIRMWARE=1"
+        );
+        return;
+    }
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/plans-test");
+    std::fs::create_dir_all(&dir).unwrap();
+    // The M0 cannot hold the torus's vertices beside 8-row bands: its torus plan is a build of its own.
+    for (board, core, groups) in [
+        (
+            "qemu-m4",
+            Core::M4,
+            vec![vec!["big", "overdraw", "small", "terrain", "torus"]],
+        ),
+        (
+            "qemu-m0",
+            Core::M0,
+            vec![vec!["big", "overdraw", "small", "terrain"], vec!["torus"]],
+        ),
+    ] {
+        for group in groups {
+            let mut files = vec![];
+            let mut want = std::collections::HashMap::new();
+            for scene in &group {
+                let p = plan(&workload(scene).unwrap(), budget(core, scene)).unwrap();
+                let f = dir.join(format!("{scene}-{}.rs", core.name()));
+                std::fs::write(&f, p.rust("the plan test")).unwrap();
+                files.push(f.display().to_string());
+                want.insert(scene.to_string(), (p.clone(), plan_hash(&p).unwrap()));
+            }
+            let out = run_board_env(board, &["plan"], &[("PLAN", &files.join(","))])
+                .unwrap_or_else(|e| panic!("{e}"));
+            let mut seen = 0;
+            for line in out.lines().filter(|l| l.starts_with("bench ")) {
+                let f = |k: &str| {
+                    host_tests::field(line, k)
+                        .unwrap_or_else(|| panic!("no {k} in {line}"))
+                        .to_string()
+                };
+                let (p, (hash, written, fragments)) = &want[&f("scene")];
+                assert_eq!(f("hash"), format!("{hash:016x}"), "{line}");
+                assert_eq!(f("pixels"), written.to_string(), "{line}");
+                assert_eq!(f("fragments"), fragments.to_string(), "{line}");
+                assert_eq!(
+                    (f("format"), f("recip")),
+                    (p.format.clone(), p.strategy.clone()),
+                    "{line}"
+                );
+                assert_eq!(f("visibility_errors"), p.visibility_errors.to_string());
+                seen += 1;
+            }
+            assert_eq!(seen, group.len(), "{board}: {out}");
+        }
+    }
+}
