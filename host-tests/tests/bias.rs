@@ -226,3 +226,65 @@ fn bias_applies_to_small_triangles() {
         assert_eq!(shown, covered, "bias {constant}, slope scale {slope}");
     }
 }
+
+/// The packed formats take the bias too (`draw_format`): a constant bias of `k` codes moves every stored code by
+/// exactly `k` (none saturates here: the triangle lies well inside the range), and a slope-scaled bias alone moves
+/// every code of a sloped triangle by the same positive amount (its `m` times the scale, one offset per triangle).
+#[test]
+fn packed_formats_take_constant_and_slope_bias() {
+    use host_tests::render_format;
+    use wraster::format::{LZ16, W16F, Z16};
+    use wraster::recip::Fast;
+    use wraster::Codec;
+    fn check<F: Codec>() {
+        let c = Rgb565::WHITE;
+        // W from 20 to 60 across the triangle: codes change along x and y.
+        let t = [
+            Vertex::new(4.0, 4.0, 20.0, c),
+            Vertex::new(60.0, 8.0, 60.0, c),
+            Vertex::new(10.0, 40.0, 40.0, c),
+        ];
+        let base = RenderState::new(1.0, 100.0).unwrap();
+        let codes = |s: RenderState| render_format::<F, Fast>(&[t], s, 64, 48).unwrap().1;
+        let plain = codes(base);
+        let clear = plain[0];
+        let mut k = base;
+        k.depth_bias = 3.0;
+        let constant = codes(k);
+        let mut sl = base;
+        sl.slope_scale_depth_bias = 1.0;
+        let slope = codes(sl);
+        let sign = if F::REVERSED { -1 } else { 1 };
+        let (mut n, mut offsets) = (0, std::collections::BTreeSet::new());
+        for ((&p, &q), &s) in plain.iter().zip(&constant).zip(&slope) {
+            if p == clear {
+                assert_eq!(
+                    (q, s),
+                    (clear, clear),
+                    "{}: a pixel outside the triangle",
+                    F::NAME
+                );
+                continue;
+            }
+            n += 1;
+            assert_eq!(q as i64 - p as i64, 3 * sign, "{}: constant bias", F::NAME);
+            offsets.insert(s as i64 - p as i64);
+        }
+        assert!(n > 500, "{}", F::NAME);
+        assert_eq!(
+            offsets.len(),
+            1,
+            "{}: one slope offset per triangle, {offsets:?}",
+            F::NAME
+        );
+        let o = *offsets.first().unwrap() * sign;
+        assert!(
+            o >= 1,
+            "{}: a slope bias moves the codes back, by {o}",
+            F::NAME
+        );
+    }
+    check::<W16F>();
+    check::<Z16>();
+    check::<LZ16>();
+}

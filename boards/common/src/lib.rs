@@ -10,7 +10,7 @@
 use core::fmt::Write;
 
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{Dimensions, Point, Size};
+use embedded_graphics_core::geometry::{OriginDimensions, Size};
 use embedded_graphics_core::pixelcolor::raw::RawU16;
 use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
 use embedded_graphics_core::primitives::Rectangle;
@@ -114,14 +114,9 @@ impl<'a> Band<'a> {
     }
 }
 
-// Its bounding box is its own rows, so a draw without a depth buffer (which takes its rows from the target) walks
-// only those.
-impl Dimensions for Band<'_> {
-    fn bounding_box(&self) -> Rectangle {
-        Rectangle::new(
-            Point::new(0, self.y0),
-            Size::new(WIDTH as u32, self.h as u32),
-        )
+impl OriginDimensions for Band<'_> {
+    fn size(&self) -> Size {
+        Size::new(WIDTH as u32, (self.y0 + self.h) as u32)
     }
 }
 
@@ -569,7 +564,11 @@ pub fn run_plan_line<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
 ) -> bool {
     match run_plan::<F, R, C, KIND>(plan, color, depth, verts, counter) {
         Ok(run) => {
-            let mut line = bench_line_of(board, core, &run, plan.format);
+            // The bench line with the plan's format in place of W16.
+            let full = bench_line(board, core, &run);
+            let mut line = heapless::String::<360>::new();
+            let (head, tail) = full.split_once(" format=W16 ").unwrap_or((&full, ""));
+            let _ = write!(line, "{head} format={} {tail}", plan.format);
             let _ = write!(
                 line,
                 " plan=1 depth_ram={} visibility_errors={}",
@@ -751,16 +750,11 @@ impl core::fmt::Display for Ratio {
 
 /// The bench line of a run (the format; keys are stable).
 pub fn bench_line(board: &str, core: &str, run: &Run) -> heapless::String<360> {
-    bench_line_of(board, core, run, "W16")
-}
-
-/// [`bench_line`] with the depth format's name.
-fn bench_line_of(board: &str, core: &str, run: &Run, format: &str) -> heapless::String<360> {
     let mut s = heapless::String::new();
     let (px, fr) = (run.stats.written as u64, run.stats.fragments as u64);
     let _ = write!(
         s,
-        "bench board={board} core={core} scene={} format={format} bands={} pixels={px} fragments={fr} triangles={} instructions={} instr_per_px={} instr_per_fragment={} instr_per_tri={} hash={:016x} recip={}",
+        "bench board={board} core={core} scene={} format=W16 bands={} pixels={px} fragments={fr} triangles={} instructions={} instr_per_px={} instr_per_fragment={} instr_per_tri={} hash={:016x} recip={}",
         run.scene,
         run.bands,
         run.triangles,
