@@ -361,46 +361,8 @@ fn draw_as<R: SpanRecip>(
             })?;
             Ok(frame)
         }
-        "LZ16" => packed::<LZ16, R>(tris, state, w, h, band_h),
-        "Z16" => packed::<Z16, R>(tris, state, w, h, band_h),
-        "W16F" => packed::<W16F, R>(tris, state, w, h, band_h),
-        "W24F" => packed::<W24F, R>(tris, state, w, h, band_h),
-        "W24FScaled" => packed::<W24FScaled, R>(tris, state, w, h, band_h),
-        "Z24" => packed::<Z24, R>(tris, state, w, h, band_h),
-        "W32F" => packed::<W32F, R>(tris, state, w, h, band_h),
-        "Z32F" => packed::<Z32F, R>(tris, state, w, h, band_h),
-        "RZ32F" => packed::<RZ32F, R>(tris, state, w, h, band_h),
-        _ => panic!("unknown format {format}"),
+        f => Ok(packed_rows::<R>(f, tris, state, w, h, band_h)?.0),
     }
-}
-
-/// A packed format's draw in bands of `band_h` rows, each cleared to the far plane first.
-fn packed<F: Codec, R: SpanRecip>(
-    tris: &[[Vertex<Rgb565>; 3]],
-    state: RenderState,
-    w: u16,
-    h: u16,
-    band_h: u16,
-) -> Result<Frame, Error> {
-    let mut frame = Frame::new(w as u32, h as u32);
-    let mut r = Rasterizer::<R>::new(state);
-    let mut bytes = vec![0u8; w as usize * band_h as usize * F::BYTES];
-    let mut y0 = 0u16;
-    while y0 < h {
-        let bh = band_h.min(h - y0);
-        let mut buf = Packed::<F>::band(
-            &mut bytes[..w as usize * bh as usize * F::BYTES],
-            w,
-            y0 as i32,
-            bh,
-        )?;
-        buf.clear(&state.range);
-        for t in tris {
-            r.draw_format(&mut frame, Some(&mut buf), t)?;
-        }
-        y0 += bh;
-    }
-    Ok(frame)
 }
 
 /// What the planner is asked for.
@@ -729,6 +691,8 @@ fn plan_hash_as<R: SpanRecip>(plan: &Plan) -> Result<(u64, u32, u32), Error> {
     Ok((hash, stats.written, stats.fragments))
 }
 
+/// A packed format's draw in bands of `band_h` rows, each cleared to the far plane first: the frame, every row's
+/// stored bytes, the stats.
 fn packed_rows<R: SpanRecip>(
     format: &str,
     tris: &[[Vertex<Rgb565>; 3]],

@@ -10,7 +10,7 @@
 use core::fmt::Write;
 
 use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{OriginDimensions, Size};
+use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Point, Size};
 use embedded_graphics_core::pixelcolor::raw::RawU16;
 use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
 use embedded_graphics_core::primitives::Rectangle;
@@ -148,6 +148,34 @@ impl DrawTarget for Band<'_> {
             }
         }
         Ok(())
+    }
+}
+
+/// A [`Band`] whose bounding box is its own rows: a draw without a depth buffer takes its rows from the target, and
+/// would otherwise walk (and count) every row above the band. (`Band` itself keeps its size from row 0: changing it
+/// moves the standard runs' code generation.)
+struct OwnRows<'b, 'a>(&'b mut Band<'a>);
+
+impl Dimensions for OwnRows<'_, '_> {
+    fn bounding_box(&self) -> Rectangle {
+        Rectangle::new(
+            Point::new(0, self.0.y0),
+            Size::new(WIDTH as u32, self.0.h as u32),
+        )
+    }
+}
+
+impl DrawTarget for OwnRows<'_, '_> {
+    type Color = Rgb565;
+    type Error = core::convert::Infallible;
+    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(
+        &mut self,
+        pixels: I,
+    ) -> Result<(), Self::Error> {
+        self.0.draw_iter(pixels)
+    }
+    fn fill_solid(&mut self, area: &Rectangle, c: Rgb565) -> Result<(), Self::Error> {
+        self.0.fill_solid(area, c)
     }
 }
 
@@ -362,7 +390,7 @@ fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
             counter.start();
             let res = tris(&mut |v, rr| {
                 if rr.0 <= b1 && rr.1 >= b0 {
-                    *stats += r.draw_format::<W16, _>(&mut band, None, v)?;
+                    *stats += r.draw_format::<W16, _>(&mut OwnRows(&mut band), None, v)?;
                 }
                 Ok(())
             });
