@@ -5,7 +5,8 @@ f64 reference (cargo-mutants itself runs only the mutated package's tests, and t
 
     python3 host-tests/mutants.py OUT.json [--jobs N] [--missed-in PREV.json] [cargo-mutants filters, e.g. --file src/edge.rs]
 
-Each mutant is judged first by the core's own unit tests (`cargo test -p wraster --lib`, about a second), then, if
+Each mutant is judged first by the core's own unit tests (`cargo test -p wraster --lib`, about a second, with every
+feature and again without `bias`, whose `cfg(not(...))` code only that build compiles), then, if
 they pass, by `host-tests/mutants/judge.rs`: every test file of host-tests/tests but the property tests, the commands
 and the firmware runs, built as one binary (a package of its own, so host-tests' binaries are not rebuilt) in the
 `mutants` profile (opt-level 1, overflow checks on, no debug info): 15 to 40 s a mutant on a 2-core VM.
@@ -22,6 +23,9 @@ import json, os, signal, subprocess, sys, threading, time
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TIMEOUT = 60
 UNIT = ["cargo", "test", "--profile", "mutants", "-p", "wraster", "--all-features", "--lib"]
+# The unit tests again in a build without `bias`: code under `cfg(not(feature = "bias"))` is compiled only there.
+UNIT_NO_BIAS = ["cargo", "test", "--profile", "mutants", "-p", "wraster", "--features", "scenes,gouraud,lighting",
+                "--lib"]
 JUDGE = ["cargo", "test", "--profile", "mutants", "-p", "wraster-mutants-judge", "--test", "judge"]
 
 
@@ -54,6 +58,10 @@ def judge(m, wt):
         if not built(UNIT, wt):
             return "unviable"
         r = run(UNIT, wt, TIMEOUT)
+        if r == 0:
+            if not built(UNIT_NO_BIAS, wt):
+                return "unviable"
+            r = run(UNIT_NO_BIAS, wt, TIMEOUT)
         if r == 0:
             if not built(JUDGE, wt):
                 return "unviable"
@@ -92,7 +100,7 @@ def main():
             subprocess.run(["git", "worktree", "add", "--detach", wt, head], cwd=REPO, check=True,
                            stdout=subprocess.DEVNULL)
         subprocess.run(["git", "checkout", "-q", "-f", "--detach", head], cwd=wt, check=True)
-        assert run(UNIT, wt) == 0 and run(JUDGE, wt) == 0, "the unmutated tree must pass"
+        assert run(UNIT, wt) == 0 and run(UNIT_NO_BIAS, wt) == 0 and run(JUDGE, wt) == 0, "the unmutated tree must pass"
         while True:
             with lock:
                 if not todo:

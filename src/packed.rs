@@ -978,3 +978,70 @@ mod zconst_tests {
         }
     }
 }
+
+#[cfg(test)]
+mod code_tests {
+    use super::Packed;
+    use crate::format::{DepthFormat, W16F, W32F};
+    use crate::raster::{Rasterizer, Vertex};
+    use crate::recip::Fast;
+    use crate::{Codec, RenderState};
+    use embedded_graphics_core::pixelcolor::BinaryColor;
+    use embedded_graphics_core::prelude::{DrawTarget, OriginDimensions, Pixel, Size};
+    use std::vec;
+
+    struct Sink;
+    impl OriginDimensions for Sink {
+        fn size(&self) -> Size {
+            Size::new(32, 32)
+        }
+    }
+    impl DrawTarget for Sink {
+        type Color = BinaryColor;
+        type Error = core::convert::Infallible;
+        fn draw_iter<I: IntoIterator<Item = Pixel<BinaryColor>>>(
+            &mut self,
+            _: I,
+        ) -> Result<(), Self::Error> {
+            Ok(())
+        }
+    }
+
+    /// A triangle facing the eye at `W = 16` in `[1, 64]` stores `W / W_far = 1/4`, a value every W format holds
+    /// exactly, so each covered pixel's code decodes to exactly 0.25 and the clear code stays elsewhere. This test
+    /// runs in every build, including one without the `bias` feature, where no offset may reach the code (the
+    /// mutation run judges a build without `bias` too: the all-features build never compiles that path).
+    #[test]
+    fn a_flat_triangle_stores_its_exact_w() {
+        fn check<F: Codec + DepthFormat>() {
+            let state = RenderState::new(1.0, 64.0).unwrap();
+            let mut bytes = vec![0u8; 32 * 32 * F::BYTES];
+            let mut buf = Packed::<F>::new(&mut bytes, 32, 32).unwrap();
+            buf.clear(&state.range);
+            let on = BinaryColor::On;
+            let t = [
+                Vertex::new(1.0, 1.0, 16.0, on),
+                Vertex::new(30.0, 2.0, 16.0, on),
+                Vertex::new(3.0, 29.0, 16.0, on),
+            ];
+            let stats = Rasterizer::<Fast>::new(state)
+                .draw_format(&mut Sink, Some(&mut buf), &t)
+                .unwrap();
+            let mut n = 0;
+            for c in bytes.chunks_exact(F::BYTES).map(F::unpack) {
+                let v = F::fraction(c, 1.0, 64.0);
+                if v != 1.0 {
+                    assert_eq!(v, 0.25, "{}: code {c}", F::NAME);
+                    n += 1;
+                }
+            }
+            assert!(
+                n > 300 && n == stats.written as usize,
+                "{}: {n} pixels",
+                F::NAME
+            );
+        }
+        check::<W16F>();
+        check::<W32F>();
+    }
+}
