@@ -21,7 +21,10 @@
 //!   then the scene's own.
 //!
 //! The first candidate within the budget is the plan: every candidate is measured by rendering, so a plan's stated
-//! error count is what its build draws. The band height is the most rows whose depth buffer fits the RAM budget.
+//! error count is what its build draws. RAM is not run time (W3 without a depth buffer costs twice its W16 build on
+//! the boards: the colour-only draw has no small-triangle path), so `--measure` ([`candidates`],
+//! [`measure_on_board`], [`rank_measured`]) runs the first candidate of each of the first three formats within the
+//! budget on the core's board and takes the fewest instructions per frame. The band height is the most rows whose depth buffer fits the RAM budget.
 use std::fmt::Write as _;
 
 use embedded_graphics::pixelcolor::raw::RawU16;
@@ -403,6 +406,14 @@ pub struct Plan {
     pub visibility_errors: u32,
     /// Candidates measured before this one was taken: `(format, strategy, range, errors)`.
     pub tried: Vec<(String, String, &'static str, u32)>,
+    /// Visibility errors of the general default build on this core, measured the same way: W16, the core's first
+    /// strategy, the scene's own depth range, the board's default bands (the figure the plan is compared with).
+    pub default_visibility_errors: u32,
+    /// How it was chosen: `ram` (the first candidate within the budget, by depth RAM, then the strategies' order)
+    /// or `measured` (the fewest instructions per frame on the core's QEMU board among [`candidates`]).
+    pub ranked_by: &'static str,
+    /// Its instructions per frame on the core's board, when measured.
+    pub instructions_per_frame: Option<f64>,
     /// Whether the plan meets the error budget (when no candidate does, the plan is the cheapest of those with the
     /// fewest errors: a scene whose surfaces intersect has pixels where they are closer than any format's step).
     pub budget_met: bool,
@@ -417,7 +428,7 @@ impl Plan {
             self.features.join(",")
         };
         format!(
-            "plan scene={} format={} strategy={} near={} far={} bands={} depth_ram={} features={} visibility_errors={} core={} band_rows={} budget_met={}",
+            "plan scene={} format={} strategy={} near={} far={} bands={} depth_ram={} features={} visibility_errors={} core={} band_rows={} budget_met={} default_visibility_errors={} ranked_by={} instructions_per_frame={}",
             self.scene,
             self.format,
             self.strategy,
@@ -429,7 +440,11 @@ impl Plan {
             self.visibility_errors,
             self.core.name(),
             self.band_rows,
-            self.budget_met
+            self.budget_met,
+            self.default_visibility_errors,
+            self.ranked_by,
+            self.instructions_per_frame
+                .map_or("-".to_string(), |n| format!("{n:.0}"))
         )
     }
 
@@ -509,6 +524,15 @@ pub fn errors_of(
 /// The cheapest plan within `budget` (see the module's docs); when no candidate meets it, the cheapest of those
 /// with the fewest errors, with `budget_met: false` (with too little depth RAM for any format, that is "none").
 pub fn plan(wl: &Workload, budget: Budget) -> Result<Plan, Error> {
+    Ok(candidates(wl, budget, 1)?.swap_remove(0))
+}
+
+/// Up to `formats` plans within `budget`, each the first candidate of its format that meets it (cheapest RAM
+/// first): what [`rank_measured`] compares on the core. When none meets it, the one plan [`plan`] falls back to.
+/// Every plan carries the candidates tried up to the last one returned.
+pub fn candidates(wl: &Workload, budget: Budget, formats: usize) -> Result<Vec<Plan>, Error> {
+    let formats = formats.max(1);
+    let mut meeting: Vec<Plan> = vec![];
     let refs: Vec<Reference> = wl
         .frames
         .iter()
@@ -529,9 +553,22 @@ pub fn plan(wl: &Workload, budget: Budget) -> Result<Plan, Error> {
         }
     }
     ranges.push(("scene", own));
+    let default_rows =
+        (budget.core.default_depth_ram(&wl.name) / (wl.w as usize * 2)).min(wl.h as usize) as u16;
+    let default_errors = errors_of(
+        wl,
+        &refs,
+        "W16",
+        budget.core.strategies()[0],
+        wl.state,
+        default_rows,
+    )?;
     let mut tried = vec![];
     let mut best: Option<Plan> = None;
     for format in FORMATS {
+        if meeting.len() >= formats {
+            break;
+        }
         let bytes = format_bytes(format);
         let row_bytes = wl.w as usize * bytes;
         let band_rows = if bytes == 0 {
@@ -548,7 +585,7 @@ pub fn plan(wl: &Workload, budget: Budget) -> Result<Plan, Error> {
         } else {
             budget.core.strategies().to_vec()
         };
-        for strategy in strategies {
+        'format: for strategy in strategies {
             for &(kind, (near, far)) in &ranges {
                 if bytes == 0 && kind == "tight" {
                     // Without a depth buffer the range only culls: keep the scene's.
@@ -570,11 +607,15 @@ pub fn plan(wl: &Workload, budget: Budget) -> Result<Plan, Error> {
                     depth_ram: row_bytes * band_rows as usize,
                     features: vec![],
                     visibility_errors: e,
+                    default_visibility_errors: default_errors,
+                    ranked_by: "ram",
+                    instructions_per_frame: None,
                     tried: vec![],
                     budget_met: e <= budget.max_visibility_errors,
                 };
                 if p.budget_met {
-                    return Ok(Plan { tried, ..p });
+                    meeting.push(p);
+                    break 'format;
                 }
                 if best.as_ref().is_none_or(|b| e < b.visibility_errors) {
                     best = Some(p);
@@ -582,11 +623,75 @@ pub fn plan(wl: &Workload, budget: Budget) -> Result<Plan, Error> {
             }
         }
     }
+    if !meeting.is_empty() {
+        return Ok(meeting
+            .into_iter()
+            .map(|p| Plan {
+                tried: tried.clone(),
+                ..p
+            })
+            .collect());
+    }
     let best = best.ok_or(Error::BufferSize {
         expected: wl.w as usize * 2,
         actual: budget.depth_ram,
     })?;
-    Ok(Plan { tried, ..best })
+    Ok(vec![Plan { tried, ..best }])
+}
+
+/// The QEMU board a core's plans run on (`qemu-m0`, `qemu-m4`; the RV32 board has no `plan` feature yet).
+pub fn board_of(core: Core) -> Option<&'static str> {
+    match core {
+        Core::M0 => Some("qemu-m0"),
+        Core::M4 => Some("qemu-m4"),
+        Core::Rv32 => None,
+    }
+}
+
+/// Each candidate's instructions per frame on its core's board: each written as a plan into `dir`, built into a
+/// firmware of its own (`PLAN=<file> cargo run --release --features plan`: what would ship; in one firmware with the
+/// others, LLVM inlines differently and a plan's count moved by up to 50%) and run under QEMU; read from its
+/// `bench` line (`instr_per_frame` for the torus's frames, else `instructions`).
+pub fn measure_on_board(cands: &[Plan], dir: &std::path::Path) -> Result<Vec<f64>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+    cands
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let board = board_of(p.core).ok_or("--measure needs the M0 or M4 board")?;
+            let f = dir.join(format!("{}-{}-{k}.rs", p.scene, p.core.name()));
+            std::fs::write(&f, p.rust("plan --measure (a candidate)"))
+                .map_err(|e| e.to_string())?;
+            let file = f.canonicalize().map_err(|e| e.to_string())?;
+            let out =
+                crate::run_board_env(board, &["plan"], &[("PLAN", &file.display().to_string())])?;
+            let line = out
+                .lines()
+                .find(|l| {
+                    l.starts_with("bench ")
+                        && crate::field(l, "scene") == Some(p.scene.as_str())
+                        && crate::field(l, "format") == Some(p.format.as_str())
+                })
+                .ok_or_else(|| format!("no bench line for {} {}:\n{out}", p.scene, p.format))?;
+            crate::field(line, "instr_per_frame")
+                .or_else(|| crate::field(line, "instructions"))
+                .and_then(|v| v.parse().ok())
+                .ok_or_else(|| format!("no instruction count in {line}"))
+        })
+        .collect()
+}
+
+/// The candidate with the fewest instructions per frame (the first, the least RAM, on a tie), marked as measured.
+pub fn rank_measured(cands: Vec<Plan>, costs: &[f64]) -> Plan {
+    let (k, _) =
+        costs.iter().enumerate().fold(
+            (0, f64::INFINITY),
+            |(bk, bc), (k, &c)| if c < bc { (k, c) } else { (bk, bc) },
+        );
+    let mut p = cands.into_iter().nth(k).expect("one cost per candidate");
+    p.ranked_by = "measured";
+    p.instructions_per_frame = Some(costs[k]);
+    p
 }
 
 /// FNV-1a 64 over bytes (the boards' `Fnv`).

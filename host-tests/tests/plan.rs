@@ -3,7 +3,8 @@
 
 use embedded_graphics::pixelcolor::Rgb565;
 use host_tests::plan::{
-    errors_of, plan, plan_hash, render_ids, workload, Budget, Core, Reference, Workload,
+    candidates, errors_of, measure_on_board, plan, plan_hash, rank_measured, render_ids, workload,
+    Budget, Core, Reference, Workload,
 };
 use host_tests::{have, run_board_env};
 use wraster::{RenderState, Vertex};
@@ -234,6 +235,64 @@ fn boards_built_from_plans_draw_the_hosts_frames() {
                 seen += 1;
             }
             assert_eq!(seen, group.len(), "{board}: {out}");
+        }
+    }
+}
+
+/// `candidates` returns, in RAM order, the first plan of each format within the budget, each with the errors it
+/// states; `plan` is the first of them. On W3 (a grid that never overlaps) no depth buffer, W16 and LZ16 all draw it
+/// without an error; on W2 (overlapping triangles) no depth buffer cannot.
+#[test]
+fn candidates_are_the_first_of_each_format_within_the_budget() {
+    let wl = workload("small").unwrap();
+    let c = candidates(&wl, budget(Core::M4, "small"), 3).unwrap();
+    let formats: Vec<&str> = c.iter().map(|p| p.format.as_str()).collect();
+    assert_eq!(formats, ["none", "W16", "LZ16"]);
+    assert!(c.iter().all(|p| p.budget_met && p.visibility_errors == 0));
+    let first = plan(&wl, budget(Core::M4, "small")).unwrap();
+    assert_eq!((first.format, first.near, first.far), ("none".to_string(), c[0].near, c[0].far));
+    let wl = workload("overdraw").unwrap();
+    let c = candidates(&wl, budget(Core::M4, "overdraw"), 2).unwrap();
+    assert_eq!(c.len(), 2);
+    assert!(c.iter().all(|p| p.format != "none" && p.budget_met));
+    assert!(c[0].tried.iter().any(|t| t.0 == "none" && t.3 > 0));
+}
+
+/// `rank_measured` takes the fewest instructions, the first (least RAM) on a tie.
+#[test]
+fn measured_ranking_takes_the_fewest_instructions() {
+    let wl = workload("small").unwrap();
+    let c = candidates(&wl, budget(Core::M4, "small"), 3).unwrap();
+    let p = rank_measured(c.clone(), &[3.0, 2.0, 2.0]);
+    assert_eq!(
+        (p.format.as_str(), p.ranked_by, p.instructions_per_frame),
+        ("W16", "measured", Some(2.0))
+    );
+    assert_eq!(rank_measured(c, &[1.0, 1.0, 5.0]).format, "none");
+}
+
+/// On the boards, W3 without a depth buffer costs more than with W16 (the colour-only draw has no small-triangle
+/// path), while W1 without one costs less: the measured ranking (`plan --measure`) takes W16 for W3 and no buffer for
+/// W1 on both cores. Needs QEMU, as `firmware.rs` (`WRASTER_SKIP_FIRMWARE=1` skips knowingly).
+#[test]
+fn measured_ranking_runs_each_candidate_on_its_board() {
+    if !have("qemu-system-arm") {
+        assert!(
+            std::env::var("WRASTER_SKIP_FIRMWARE").is_ok_and(|v| v == "1"),
+            "QEMU (qemu-system-arm) is missing: install it (.ci/run shows how) or set WRASTER_SKIP_FIRMWARE=1"
+        );
+        return;
+    }
+    let dir =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/plans-test/measured");
+    for core in [Core::M4, Core::M0] {
+        for (scene, want) in [("small", "W16"), ("big", "none")] {
+            let wl = workload(scene).unwrap();
+            let c = candidates(&wl, budget(core, scene), 2).unwrap();
+            let costs = measure_on_board(&c, &dir).unwrap();
+            assert!(costs.iter().all(|&n| n > 0.0), "{costs:?}");
+            let p = rank_measured(c, &costs);
+            assert_eq!(p.format, want, "{scene} on {core:?}: {costs:?}");
         }
     }
 }

@@ -16,20 +16,21 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use panic_semihosting as _;
 use wraster::mesh::Projected;
-#[cfg(not(feature = "size-probe"))]
-use wraster::recip::Fast;
-#[cfg(not(feature = "size-probe"))]
-use wraster::recip::{Exact, PrevPixel};
+#[cfg(not(any(feature = "size-probe", feature = "plan")))]
+use wraster::recip::{Exact, Fast, PrevPixel};
+#[cfg(not(feature = "plan"))]
 use wraster::recip::{FastDiv, SpanRecip};
+#[cfg(not(feature = "plan"))]
 use wraster::scenes::torus::VERTICES;
-#[cfg(not(feature = "torus"))]
+#[cfg(not(any(feature = "torus", feature = "plan")))]
 use wraster_board::run_all;
-#[cfg(feature = "torus")]
+#[cfg(all(feature = "torus", not(feature = "plan")))]
 use wraster_board::run_torus_line;
 use wraster_board::{SysTick, HEIGHT, WIDTH};
 
 const PIXELS: usize = WIDTH as usize * HEIGHT as usize;
 
+#[cfg(not(feature = "plan"))]
 fn all<R: SpanRecip>(
     color: &mut [u16],
     depth: &mut [u16],
@@ -51,6 +52,7 @@ fn all<R: SpanRecip>(
     })
 }
 
+#[cfg(not(feature = "plan"))]
 #[entry]
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];
@@ -62,29 +64,6 @@ fn main() -> ! {
     }; VERTICES];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 40, 1);
-    // `--features plan` (with `PLAN=<plan files>`) runs the planner's plans instead: each with only what it chose.
-    #[cfg(feature = "plan")]
-    {
-        use wraster_board::plans;
-        const _: () = assert!(
-            plans::COUNT > 0 && plans::MAX_DEPTH_RAM <= PIXELS * 2,
-            "--features plan needs PLAN=<file>,... (host-tests' plan binary writes them) within a W16 frame of RAM"
-        );
-        let ok = plans::run_all_plans(
-            "qemu-m4",
-            "m4",
-            COLOR,
-            DEPTH,
-            VERTS,
-            &mut counter,
-            &mut |a| hprintln!("{}", a),
-        );
-        debug::exit(if ok {
-            debug::EXIT_SUCCESS
-        } else {
-            debug::EXIT_FAILURE
-        });
-    }
     // This core's default: the fast tier seeded by its divide instruction.
     let ok = all::<FastDiv>(COLOR, DEPTH, VERTS, &mut counter);
     // `--features size-probe` links the default path only, to measure the library's share of .text (README).
@@ -103,6 +82,58 @@ fn main() -> ! {
             VERTS,
             &mut counter,
         );
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// `--features plan` (with `PLAN=<plan files>`): the planner's plans instead, each with only what it chose; the depth
+/// buffer is sized from the plans (none when no plan keeps depth) and the torus's vertex store is there only when a
+/// plan draws it, so `.bss` shows what a plan saves.
+#[cfg(feature = "plan")]
+mod plan_buffers {
+    use wraster_board::plans;
+    pub const DEPTH_LEN: usize = plans::MAX_DEPTH_RAM.div_ceil(2);
+    pub const VERTS_LEN: usize = if plans::HAS_TORUS {
+        wraster::scenes::torus::VERTICES
+    } else {
+        0
+    };
+    const _: () = assert!(
+        plans::COUNT > 0 && plans::MAX_DEPTH_RAM <= super::PIXELS * 2,
+        "--features plan needs PLAN=<file>,... (host-tests' plan binary writes them) within a W16 frame of RAM"
+    );
+}
+
+#[cfg(feature = "plan")]
+use plan_buffers::{DEPTH_LEN, VERTS_LEN};
+
+#[cfg(feature = "plan")]
+#[entry]
+fn main() -> ! {
+    static mut COLOR: [u16; PIXELS] = [0; PIXELS];
+    static mut DEPTH: [u16; DEPTH_LEN] = [0; DEPTH_LEN];
+    static mut VERTS: [Projected; VERTS_LEN] = [Projected {
+        x: 0.0,
+        y: 0.0,
+        rhw: 0.0,
+    }; VERTS_LEN];
+    let cp = cortex_m::Peripherals::take().unwrap();
+    let mut counter = SysTick::new(cp.SYST, 40, 1);
+    let ok = wraster_board::plans::run_all_plans(
+        "qemu-m4",
+        "m4",
+        COLOR,
+        DEPTH,
+        VERTS,
+        &mut counter,
+        &mut |a| hprintln!("{}", a),
+    );
     debug::exit(if ok {
         debug::EXIT_SUCCESS
     } else {

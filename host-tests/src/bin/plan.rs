@@ -1,16 +1,23 @@
 //! The scene planner: `cargo run --release -p host-tests --bin plan -- <scene> [--max-visibility-errors N]
-//! [--depth-ram BYTES] [--core m0|m4|rv32] [--out FILE]` for `big`, `overdraw`, `small`, `terrain` and `torus` (W4's
+//! [--depth-ram BYTES] [--core m0|m4|rv32] [--out FILE] [--measure]` for `big`, `overdraw`, `small`, `terrain` and `torus` (W4's
 //! 8 frames). Measures the scene against the f64 reference, picks the cheapest build within the budget (default: 0
 //! visibility errors; the core's board's depth RAM; `m4`), writes it as Rust source for a board's build.rs
 //! (default `target/plans/<scene>-<core>.rs`; `PLAN=<file> cargo run --release --features plan` in a board) and
 //! prints, last, `plan scene=.. format=.. strategy=.. near=.. far=.. bands=.. depth_ram=.. features=.. visibility_errors=..`.
+//! `--measure` ranks by cost on the core instead of by RAM: the first candidate within the budget of each of the
+//! first three formats that have one (no depth buffer, W16, LZ16, ...) is built into a firmware of its own for the
+//! core's QEMU board and run,
+//! and the plan is the one with the fewest instructions per frame (needs the board's target and QEMU).
 //! See `host_tests::plan` for the candidates and what a visibility error is.
-use host_tests::plan::{plan, workload, Budget, Core, Reference};
+use host_tests::plan::{
+    candidates, measure_on_board, rank_measured, workload, Budget, Core, Reference,
+};
 use wraster::format::{LZ16, W16, W16F, W24F, Z16, Z24};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let (mut scene, mut max, mut ram, mut core, mut out) = (None, 0u32, None, Core::M4, None);
+    let mut measure = false;
     while let Some(a) = args.next() {
         let mut val = || args.next().ok_or(format!("{a} needs a value"));
         match a.as_str() {
@@ -18,11 +25,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--depth-ram" => ram = Some(val()?.parse()?),
             "--core" => core = Core::parse(&val()?).ok_or("--core is m0, m4 or rv32")?,
             "--out" => out = Some(std::path::PathBuf::from(val()?)),
+            "--measure" => measure = true,
             s if !s.starts_with('-') && scene.is_none() => scene = Some(s.to_string()),
             s => return Err(format!("unexpected argument {s:?}").into()),
         }
     }
-    let scene = scene.ok_or("usage: plan <big|overdraw|small|terrain|torus> [--max-visibility-errors N] [--depth-ram BYTES] [--core m0|m4|rv32] [--out FILE]")?;
+    let scene = scene.ok_or("usage: plan <big|overdraw|small|terrain|torus> [--max-visibility-errors N] [--depth-ram BYTES] [--core m0|m4|rv32] [--out FILE] [--measure]")?;
     let wl = workload(&scene)?;
     let budget = Budget {
         max_visibility_errors: max,
@@ -58,7 +66,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         gap(&|r| r.min_gap_steps::<W24F>(f, n, f)),
         gap(&|r| r.min_gap_steps::<Z24>(f, n, f)),
     );
-    let p = plan(&wl, budget)?;
+    let cands = candidates(&wl, budget, if measure { 3 } else { 1 })?;
+    let p = if measure && cands[0].budget_met {
+        let dir =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/plans/candidates");
+        let costs = measure_on_board(&cands, &dir)?;
+        for (c, n) in cands.iter().zip(&costs) {
+            println!(
+                "measured format={} strategy={} instructions_per_frame={n:.0} visibility_errors={}",
+                c.format, c.strategy, c.visibility_errors
+            );
+        }
+        rank_measured(cands, &costs)
+    } else {
+        cands
+            .into_iter()
+            .next()
+            .expect("candidates returns at least one plan")
+    };
     for (format, strategy, range, e) in &p.tried {
         println!(
             "candidate format={format} strategy={strategy} range={range} visibility_errors={e}"
