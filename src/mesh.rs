@@ -8,13 +8,14 @@
 //! their positions, rejected when all three vertices lie outside one plane, culled by the sign of `det[x y w]` (the
 //! homogeneous back-face test, right for vertices behind the eye too) and clipped ([`crate::clip`]).
 //! [`Rasterizer::draw_mesh`] does both for a whole frame. Everything is f32; all checks happen in
-//! `transform_mesh`, before anything is drawn.
+//! `transform_mesh`, before anything is drawn. [`Sphere::visible`] tells, for the price of one point's transform,
+//! whether a mesh can reach the screen at all, so a mesh out of view need not be transformed.
 //!
 //! ```
 //! use embedded_graphics_core::pixelcolor::Rgb565;
 //! use embedded_graphics_core::prelude::*;
 //! use wraster::clip::Viewport;
-//! use wraster::mesh::{Colors, Mesh, Projected};
+//! use wraster::mesh::{Colors, Mesh, Projected, Sphere};
 //! use wraster::projection::{Camera, Mat4};
 //! use wraster::{DepthStore, Rasterizer};
 //!
@@ -42,10 +43,17 @@
 //! let mut depth = DepthStore::<64, 48>::new();
 //! let mut scratch = [Projected::default(); 8];
 //! let model = Mat4::rotation_y(0.3);
-//! let stats = r.draw_mesh(&mut Screen, &mut depth.view(), &cube, &camera.model_matrix(&model),
-//!                         &Viewport::new(0.0, 0.0, 64.0, 48.0), &mut scratch)?;
+//! let vp = Viewport::new(0.0, 0.0, 64.0, 48.0);
+//! let stats = r.draw_mesh(&mut Screen, &mut depth.view(), &cube, &camera.model_matrix(&model), &vp, &mut scratch)?;
 //! assert_eq!(stats.culled, 6); // the six back-facing triangles
 //! assert!(stats.written > 200); // about a tenth of the 64 x 48 screen
+//!
+//! // A mesh out of view costs a sphere test, not a transform: test before drawing.
+//! let sphere = Sphere::enclosing(&positions)?;
+//! let range = camera.render_state()?.range;
+//! assert!(sphere.visible(&camera.model_matrix(&model), &vp, Size::new(64, 48), &range));
+//! let behind = model * Mat4::translation([0.0, 0.0, 20.0]); // the eye looks from z = 5 towards the origin
+//! assert!(!sphere.visible(&camera.model_matrix(&behind), &vp, Size::new(64, 48), &range));
 //! # Ok::<(), wraster::Error>(())
 //! ```
 
@@ -335,5 +343,127 @@ impl<R: SpanRecip> Rasterizer<R> {
             self.draw_gouraud(target, depth, &v)
         })?;
         Ok(stats)
+    }
+}
+
+/// A sphere enclosing a mesh, in its object space: the cheap test before a frame's transform
+/// ([`Sphere::visible`]): a mesh wholly outside the view costs one point's transform and six plane tests, not a
+/// transform of every vertex.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre, object space.
+    pub center: [f32; 3],
+    /// Radius, object units.
+    pub radius: f32,
+}
+
+impl Sphere {
+    /// A sphere holding every point of `positions`: the centre of their bounding box and the largest distance from
+    /// it, rounded up (distances scaled by the largest coordinate difference, so no square overflows; the scaling,
+    /// squares, sum and square root carry under `2^-21` relative, and the radius is widened by `2^-18`, so every
+    /// position lies inside in exact arithmetic). Not the smallest sphere (within `sqrt(3)` of it), but one
+    /// pass and no iteration. [`Error::NonFinite`] for a NaN or infinite coordinate; an empty slice gives radius 0
+    /// at the origin. A box whose size overflows f32 gives an infinite radius, which [`Sphere::visible`] never culls.
+    pub fn enclosing(positions: &[[f32; 3]]) -> Result<Sphere, Error> {
+        if positions.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(Error::NonFinite);
+        }
+        let Some(first) = positions.first() else {
+            return Ok(Sphere {
+                center: [0.0; 3],
+                radius: 0.0,
+            });
+        };
+        let (mut lo, mut hi) = (*first, *first);
+        for p in positions {
+            for i in 0..3 {
+                lo[i] = lo[i].min(p[i]);
+                hi[i] = hi[i].max(p[i]);
+            }
+        }
+        // Halves first: `lo + hi` may overflow where the centre does not.
+        let center = [0, 1, 2].map(|i| lo[i] * 0.5 + hi[i] * 0.5);
+        // Distances scaled by the largest coordinate difference `s`, so their squares cannot overflow or underflow.
+        let s = positions.iter().fold(0.0f32, |m, p| {
+            (0..3).fold(m, |m, i| m.max((p[i] - center[i]).abs()))
+        });
+        if s == 0.0 {
+            return Ok(Sphere {
+                center,
+                radius: 0.0,
+            });
+        }
+        let r2 = positions.iter().fold(0.0f32, |m, p| {
+            let d = [0, 1, 2].map(|i| (p[i] - center[i]) / s);
+            m.max(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        });
+        let radius = s * crate::projection::sqrt(r2) * (1.0 + 1.0 / 262_144.0);
+        Ok(Sphere {
+            center,
+            radius: if radius.is_finite() {
+                radius
+            } else {
+                f32::INFINITY
+            },
+        })
+    }
+
+    /// Whether any of the sphere can reach the screen: `false` only when it lies wholly outside one of the six
+    /// planes bounding what a draw can write: the screen rectangle `[0, size.width] x [0, size.height]` mapped back
+    /// through `vp` (so a target larger than the viewport, drawn into through the guard band, is allowed for), the
+    /// near plane `W = W_near` and the far plane `W = W_far` of `range` (the range test writes nothing beyond it).
+    /// `m` takes the sphere's object space to clip space, as for [`Rasterizer::transform_mesh`] (a camera's
+    /// `model_matrix`).
+    ///
+    /// Each plane is `k . c + k_c >= 0` in clip space (for `w > 0`, where a point can be drawn at all; screen
+    /// `x >= 0` is `sx x + ox w >= 0`, ...), so in object space `L(p) = a . p + a_3` with `a = M k`; the sphere is
+    /// outside when `L(centre) < -radius |a|`. The centre is transformed once (its clip `x`, `y`, `w`), `|a|^2` comes
+    /// from the Gram products of `M`'s `x`, `y` and `w` columns, and the test is compared squared (no square root).
+    /// Rounding: `L` errs by under `2^-20` of `T`, the sum of its terms' magnitudes, and `|a|^2` by under `2^-20` of
+    /// `B`, its terms' magnitudes; the test subtracts `2^-16 T` from `-L` and adds `2^-20 B` to `|a|^2`, so a mesh is
+    /// culled only when the exact test would cull it. A NaN or overflow anywhere gives `true`.
+    pub fn visible(
+        &self,
+        m: &Mat4,
+        vp: &Viewport,
+        size: embedded_graphics_core::geometry::Size,
+        range: &crate::DepthRange,
+    ) -> bool {
+        // The screen mapping (as `clip::Planes`): x = ox + (x/w) sx, y = oy - (y/w) sy.
+        let (sx, sy) = (vp.width / vp.clip_width, vp.height / vp.clip_height);
+        let (ox, oy) = (vp.x - vp.clip_x * sx, vp.y + vp.clip_y * sy);
+        if !(sx.is_finite() && sy.is_finite() && ox.is_finite() && oy.is_finite()) {
+            return true;
+        }
+        let (c, r, m) = (self.center, self.radius, &m.0);
+        // The centre's clip x, y, w and their terms' magnitudes; the Gram products of the columns.
+        let col = |j: usize| {
+            let v = c[0] * m[0][j] + c[1] * m[1][j] + c[2] * m[2][j] + m[3][j];
+            let g = (c[0] * m[0][j]).abs()
+                + (c[1] * m[1][j]).abs()
+                + (c[2] * m[2][j]).abs()
+                + m[3][j].abs();
+            (v, g)
+        };
+        let dot = |i: usize, j: usize| m[0][i] * m[0][j] + m[1][i] * m[1][j] + m[2][i] * m[2][j];
+        let ((x, gx), (y, gy), (w, gw)) = (col(0), col(1), col(3));
+        let (xx, yy, ww, xw, yw) = (dot(0, 0), dot(1, 1), dot(3, 3), dot(0, 3), dot(1, 3));
+        // Outside plane `ka * (x or y) + kw * w + kc >= 0`, column Gram products `aa`, `aw` for its axis.
+        let outside = |ka: f32, v: f32, g: f32, aa: f32, aw: f32, kw: f32, kc: f32| {
+            let l = ka * v + kw * w + kc;
+            let t = ka.abs() * g + kw.abs() * gw + kc.abs();
+            let d = -l - t * (1.0 / 65_536.0);
+            let a2 = ka * ka * aa + 2.0 * ka * kw * aw + kw * kw * ww;
+            let b = ka * ka * aa + (2.0 * ka * kw * aw).abs() + kw * kw * ww;
+            // NaN (an overflow) fails every comparison: not outside.
+            d > 0.0 && t.is_finite() && d * d > r * r * (a2 + b * (1.0 / 1_048_576.0))
+        };
+        let (wd, ht) = (size.width as f32, size.height as f32);
+        !(outside(sx, x, gx, xx, xw, ox, 0.0) // screen x >= 0
+            || outside(-sx, x, gx, xx, xw, wd - ox, 0.0) // screen x <= width
+            || outside(-sy, y, gy, yy, yw, oy, 0.0) // screen y >= 0
+            || outside(sy, y, gy, yy, yw, ht - oy, 0.0) // screen y <= height
+            || outside(0.0, 0.0, 0.0, 0.0, 0.0, 1.0, -range.near()) // W >= W_near
+            || outside(0.0, 0.0, 0.0, 0.0, 0.0, -1.0, range.far())) // W <= W_far
     }
 }

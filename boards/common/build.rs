@@ -119,14 +119,12 @@ fn plans() {
         .unwrap();
         writeln!(
             calls,
-            "    ok &= crate::run_plan_line::<p{k}::PlanFormat, p{k}::PlanStrategy, C, {{ p{k}::PLAN_KIND }}>(board, core, &p{k}::PLAN, color, depth, verts, counter, &mut *print);"
+            "    ok &= crate::run_plan_line::<p{k}::PlanFormat, p{k}::PlanStrategy, C, {{ p{k}::PLAN_KIND }}, {{ p{k}::PLAN_SCENE }}>(board, core, &p{k}::PLAN, color, depth, verts, counter, &mut *print);"
         )
         .unwrap();
         ram.push(format!("p{k}::PLAN.depth_ram"));
         rows.push(format!("if p{k}::PLAN_KIND == crate::NO_DEPTH {{ 0 }} else {{ p{k}::PLAN.band_rows as usize }}"));
-        torus.push(format!(
-            "p{k}::PLAN.scene.len() == 5 && p{k}::PLAN.scene.as_bytes()[0] == b't'"
-        ));
+        torus.push(format!("p{k}::PLAN_SCENE == crate::TORUS_SCENE"));
     }
     let max = |v: &[String]| {
         v.iter()

@@ -8,6 +8,7 @@
 
 use super::{Bytes, Canvas, Guarded};
 use embedded_graphics_core::pixelcolor::Rgb565;
+use embedded_graphics_core::prelude::Size;
 use wraster::clip::Viewport;
 use wraster::format::{W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
 use wraster::input::{I24F8, U16F16, U1F31, U8F24};
@@ -558,6 +559,15 @@ pub fn world(data: &[u8]) {
     mdepth.check();
     if let Err(e) = mwhole {
         untouched(e, &mcanvas, &blank, mdepth.data(), &cleared);
+    }
+    // The bounding-sphere cull: a mesh it rejects draws nothing (the sphere holds every position, used or not).
+    if let Ok(sphere) = wraster::mesh::Sphere::enclosing(&positions) {
+        if !sphere.visible(&m, &vp, Size::new(w as u32, h as u32), &st.range) {
+            if let Ok(s) = &mwhole {
+                assert_eq!(s.written, 0, "culled by its sphere {sphere:?}, yet drawn");
+            }
+            assert!(mcanvas.same_picture(&blank) && mdepth.data() == &cleared[..]);
+        }
     }
     if !gouraud {
         // draw_mesh is transform_mesh then draw_mesh_frame.

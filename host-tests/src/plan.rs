@@ -484,6 +484,15 @@ impl Plan {
             "/// Its depth path.\npub const PLAN_KIND: u8 = crate::{kind};"
         )
         .unwrap();
+        let scene = wraster::scenes::Scene::ALL
+            .iter()
+            .position(|x| x.name() == self.scene)
+            .map_or("crate::TORUS_SCENE".to_string(), |k| k.to_string());
+        writeln!(
+            s,
+            "/// Its scene: the index in `SCENES`, or `TORUS_SCENE`.\npub const PLAN_SCENE: usize = {scene};"
+        )
+        .unwrap();
         writeln!(
             s,
             "/// The plan.\npub const PLAN: crate::PlanData = crate::PlanData {{ scene: {:?}, format: {:?}, near: f32::from_bits({:#010x}), far: f32::from_bits({:#010x}), band_rows: {}, depth_ram: {}, visibility_errors: {} }};",

@@ -126,7 +126,10 @@ pub fn step_plot(rows: &[Row], n: f64, f: f64, path: &std::path::Path) {
     )
     .draw(&mut disp)
     .unwrap();
-    for (k, r) in rows.iter().enumerate() {
+    // Every analytic line first, then every format's measured dots over them, so no line hides a format's dots;
+    // each format's dots sit at its own phase of the sampled distances (W16's and LZ16's steps, `f / 65535` and
+    // `(f - n) / 65535`, nearly coincide: at one phase their dots would cover each other), W16's drawn last and ringed.
+    for r in rows {
         let line = PrimitiveStyle::with_stroke(r.color, 1);
         for pair in ds.windows(2) {
             let (a, b) = ((r.analytic)(pair[0], n, f), (r.analytic)(pair[1], n, f));
@@ -137,20 +140,41 @@ pub fn step_plot(rows: &[Row], n: f64, f: f64, path: &std::path::Path) {
                     .unwrap();
             }
         }
-        for &d in ds.iter().step_by(3) {
+    }
+    let phases = 4;
+    let mut order: Vec<usize> = (0..rows.len()).collect();
+    order.sort_by_key(|&k| rows[k].name == "W16");
+    for &k in &order {
+        let r = &rows[k];
+        for &d in ds.iter().skip(k % phases).step_by(phases) {
             let s = (r.step)(d, n, f);
             if s > 0.0 {
-                Circle::with_center(Point::new(x(d), y(s)), 4)
+                let c = Point::new(x(d), y(s));
+                if r.name == "W16" {
+                    Circle::with_center(c, 8)
+                        .into_styled(PrimitiveStyle::with_stroke(Rgb888::BLACK, 1))
+                        .draw(&mut disp)
+                        .unwrap();
+                }
+                Circle::with_center(c, 5)
                     .into_styled(PrimitiveStyle::with_fill(r.color))
                     .draw(&mut disp)
                     .unwrap();
             }
         }
+    }
+    for (k, r) in rows.iter().enumerate() {
         let ly = top + 20 + 16 * k as i32;
         Circle::with_center(Point::new(w - right + 15, ly - 3), 6)
             .into_styled(PrimitiveStyle::with_fill(r.color))
             .draw(&mut disp)
             .unwrap();
+        if r.name == "W16" {
+            Circle::with_center(Point::new(w - right + 15, ly - 3), 9)
+                .into_styled(PrimitiveStyle::with_stroke(Rgb888::BLACK, 1))
+                .draw(&mut disp)
+                .unwrap();
+        }
         Text::new(r.name, Point::new(w - right + 25, ly), text)
             .draw(&mut disp)
             .unwrap();
@@ -168,6 +192,8 @@ pub struct Point2 {
     pub label: String,
     /// On the Pareto front.
     pub pareto: bool,
+    /// Marked with a blue ring and this label (the scene planner's choice).
+    pub mark: Option<String>,
 }
 
 fn save(disp: &SimulatorDisplay<Rgb888>, path: &std::path::Path) {
@@ -267,6 +293,18 @@ pub fn pareto_plot(
             .into_styled(PrimitiveStyle::with_fill(c))
             .draw(&mut disp)
             .unwrap();
+    }
+    let blue = MonoTextStyle::new(&FONT_6X10, Rgb888::CSS_BLUE);
+    for p in points {
+        if let Some(m) = &p.mark {
+            Circle::with_center(Point::new(x(p.x), y(p.y)), 15)
+                .into_styled(PrimitiveStyle::with_stroke(Rgb888::CSS_BLUE, 2))
+                .draw(&mut disp)
+                .unwrap();
+            Text::new(m, Point::new(x(p.x) - 20, y(p.y) + 22), blue)
+                .draw(&mut disp)
+                .unwrap();
+        }
     }
     for (k, p) in front.iter().enumerate() {
         let dy = if k % 2 == 0 { -6 } else { 12 };

@@ -250,7 +250,10 @@ fn candidates_are_the_first_of_each_format_within_the_budget() {
     assert_eq!(formats, ["none", "W16", "LZ16"]);
     assert!(c.iter().all(|p| p.budget_met && p.visibility_errors == 0));
     let first = plan(&wl, budget(Core::M4, "small")).unwrap();
-    assert_eq!((first.format, first.near, first.far), ("none".to_string(), c[0].near, c[0].far));
+    assert_eq!(
+        (first.format, first.near, first.far),
+        ("none".to_string(), c[0].near, c[0].far)
+    );
     let wl = workload("overdraw").unwrap();
     let c = candidates(&wl, budget(Core::M4, "overdraw"), 2).unwrap();
     assert_eq!(c.len(), 2);

@@ -73,6 +73,9 @@ pub const NO_DEPTH: u8 = 0;
 pub const LEAN_W16: u8 = 1;
 /// A packed format through `Rasterizer::draw_format`.
 pub const PACKED: u8 = 2;
+/// A plan's scene (its `PLAN_SCENE`, a const generic of [`run_plan`], so a firmware links only the path its scene
+/// takes): W4's torus; a standard scene is its index in [`SCENES`].
+pub const TORUS_SCENE: usize = usize::MAX;
 
 /// The plans named by `PLAN` at build time (none without it).
 pub mod plans {
@@ -447,7 +450,7 @@ fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
 /// torus is transformed by the mesh path each frame and its triangles drawn from the transformed vertices (the
 /// mesh path's own draw takes a W16 buffer only). `depth` must hold the plan's bands (`PlanData::depth_ram` bytes)
 /// and `color` at least one colour band.
-pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
+pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE: usize>(
     plan: &PlanData,
     color: &mut [u16],
     depth: &mut [u16],
@@ -456,7 +459,7 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
 ) -> Result<Run, Error> {
     let mut stats = Stats::default();
     let mut hash = Fnv::default();
-    if plan.scene == "torus" {
+    if SCENE == TORUS_SCENE {
         use wraster::scenes::torus;
         let cam = torus::camera()?;
         let mut state = cam.render_state()?;
@@ -545,10 +548,7 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
             hash: hash.0,
         });
     }
-    let scene = SCENES
-        .iter()
-        .find(|s| s.name == plan.scene)
-        .ok_or(Error::IndexOutOfRange)?;
+    let scene = SCENES.get(SCENE).ok_or(Error::IndexOutOfRange)?;
     let mut state = RenderState::new(scene.near, scene.far)?;
     state.range = wraster::DepthRange::new(plan.near, plan.far)?;
     let (instructions, bands) = run_planned_tris::<F, R, C, KIND>(
@@ -580,7 +580,7 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
 /// [`run_plan`] and its `bench` line, with `format=` the plan's and the added keys `plan=1 depth_ram=..
 /// visibility_errors=..` (and `frames=8 instr_per_frame=` for the torus), or an `error` line; `false` on an error.
 #[allow(clippy::too_many_arguments)]
-pub fn run_plan_line<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
+pub fn run_plan_line<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE: usize>(
     board: &str,
     core: &str,
     plan: &PlanData,
@@ -590,19 +590,16 @@ pub fn run_plan_line<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
     counter: &mut C,
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
-    match run_plan::<F, R, C, KIND>(plan, color, depth, verts, counter) {
+    match run_plan::<F, R, C, KIND, SCENE>(plan, color, depth, verts, counter) {
         Ok(run) => {
-            // The bench line with the plan's format in place of W16.
-            let full = bench_line(board, core, &run);
-            let mut line = heapless::String::<360>::new();
-            let (head, tail) = full.split_once(" format=W16 ").unwrap_or((&full, ""));
-            let _ = write!(line, "{head} format={} {tail}", plan.format);
+            // The bench line with the plan's format.
+            let mut line = bench_line_of(board, core, plan.format, &run);
             let _ = write!(
                 line,
                 " plan=1 depth_ram={} visibility_errors={}",
                 plan.depth_ram, plan.visibility_errors
             );
-            if plan.scene == "torus" {
+            if SCENE == TORUS_SCENE {
                 let frames = wraster::scenes::torus::FRAMES as u64;
                 let _ = write!(
                     line,
@@ -766,6 +763,66 @@ pub fn run_torus_line<R: SpanRecip, C: Counter>(
     }
 }
 
+/// What the bounding-sphere cull costs and saves on W4 (`wraster::mesh::Sphere`): the instructions of
+/// `Sphere::visible` for frame 0's matrix (the torus in view: the cull passes it) and for the torus moved behind the
+/// eye (culled), each the mean of 64 calls (one SysTick tick is 40 or 62.5 instructions), against one
+/// `transform_mesh` of frame 0 (what a culled mesh does not pay). Prints
+/// `cull board=.. core=.. scene=torus in_view=.. outside=.. transform=.. culled_outside=..`; `false` on an error or
+/// when the cull gets either case wrong.
+pub fn cull_line<C: Counter>(
+    board: &str,
+    core: &str,
+    verts: &mut [Projected],
+    counter: &mut C,
+    mut print: impl FnMut(core::fmt::Arguments<'_>),
+) -> bool {
+    use wraster::mesh::Sphere;
+    use wraster::scenes::torus;
+    let run = |verts: &mut [Projected], counter: &mut C| -> Result<(u64, u64, u64, bool, bool), Error> {
+        let cam = torus::camera()?;
+        let state = cam.render_state()?;
+        let r = Rasterizer::<wraster::recip::Fast>::new(state);
+        let mesh = Mesh {
+            positions: &TORUS_POSITIONS,
+            indices: &TORUS_INDICES,
+            colors: Colors::PerFace(&TORUS_COLORS),
+        };
+        let vp = Viewport::new(0.0, 0.0, WIDTH as f32, HEIGHT as f32);
+        let size = embedded_graphics_core::geometry::Size::new(WIDTH as u32, HEIGHT as u32);
+        let sphere = Sphere::enclosing(&TORUS_POSITIONS)?;
+        let m_in = cam.model_matrix(&torus::model(0));
+        // The eye is at z = 3 looking at the origin: z = 10 is behind it.
+        let m_out = cam.model_matrix(&(torus::model(0) * wraster::projection::Mat4::translation([0.0, 0.0, 10.0])));
+        let mut mean = |m: &wraster::projection::Mat4| {
+            let mut v = true;
+            counter.start();
+            for _ in 0..64 {
+                v &= core::hint::black_box(&sphere).visible(core::hint::black_box(m), &vp, size, &state.range);
+            }
+            (counter.stop() / 64, v)
+        };
+        let (i_in, v_in) = mean(&m_in);
+        let (i_out, v_out) = mean(&m_out);
+        counter.start();
+        let f = r.transform_mesh(&mesh, &m_in, &vp, verts);
+        let t = counter.stop();
+        f?;
+        Ok((i_in, i_out, t, v_in, !v_out))
+    };
+    match run(verts, counter) {
+        Ok((i_in, i_out, t, kept, culled)) => {
+            print(format_args!(
+                "cull board={board} core={core} scene=torus in_view={i_in} outside={i_out} transform={t} culled_outside={culled}"
+            ));
+            kept && culled
+        }
+        Err(e) => {
+            print(format_args!("error board={board} scene=torus cull {e}"));
+            false
+        }
+    }
+}
+
 /// `num / den` with one decimal, by integers.
 struct Ratio(u64, u64);
 
@@ -778,11 +835,16 @@ impl core::fmt::Display for Ratio {
 
 /// The bench line of a run (the format; keys are stable).
 pub fn bench_line(board: &str, core: &str, run: &Run) -> heapless::String<360> {
+    bench_line_of(board, core, "W16", run)
+}
+
+/// [`bench_line`] with another depth format's name (a plan's).
+pub fn bench_line_of(board: &str, core: &str, format: &str, run: &Run) -> heapless::String<360> {
     let mut s = heapless::String::new();
     let (px, fr) = (run.stats.written as u64, run.stats.fragments as u64);
     let _ = write!(
         s,
-        "bench board={board} core={core} scene={} format=W16 bands={} pixels={px} fragments={fr} triangles={} instructions={} instr_per_px={} instr_per_fragment={} instr_per_tri={} hash={:016x} recip={}",
+        "bench board={board} core={core} scene={} format={format} bands={} pixels={px} fragments={fr} triangles={} instructions={} instr_per_px={} instr_per_fragment={} instr_per_tri={} hash={:016x} recip={}",
         run.scene,
         run.bands,
         run.triangles,

@@ -73,6 +73,12 @@ fn main() -> ! {
         & all::<Fast>(COLOR, DEPTH, VERTS, &mut counter)
         & all::<Exact>(COLOR, DEPTH, VERTS, &mut counter)
         & all::<PrevPixel>(COLOR, DEPTH, VERTS, &mut counter);
+    // W4's build also measures the bounding-sphere cull (README: leaving work out at run time).
+    #[cfg(all(feature = "torus", not(feature = "size-probe")))]
+    let ok = ok
+        & wraster_board::cull_line("qemu-m4", "m4", VERTS, &mut counter, |line| {
+            hprintln!("{}", line)
+        });
     // `--features f32-div` adds the f32-division reciprocal (one VDIV on this core), for comparison (README).
     #[cfg(feature = "f32-div")]
     let ok = ok

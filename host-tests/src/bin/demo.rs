@@ -4,7 +4,11 @@
 
 use std::time::Instant;
 
+use embedded_graphics::mono_font::{ascii::FONT_6X10, MonoTextStyle};
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
+use embedded_graphics::prelude::*;
+use embedded_graphics::primitives::{PrimitiveStyle, Rectangle};
+use embedded_graphics::text::{Baseline, Text};
 use host_tests::{reference_frame, render, render_format, Frame};
 use wraster::format::{DepthFormat, W16, W16F, Z16};
 use wraster::recip::{DefaultRecip, PerPixel};
@@ -102,6 +106,21 @@ fn side_by_side(
             };
             out.px[(row * (h + 4) + i / w) * out.w as usize + k * (w + 4) + i % w] = c;
         }
+        // The panel's label, white on black in its top-left corner: the format, the scene, the differing pixels.
+        let label = format!("{format} ({name}): {differ} px differ");
+        let at = Point::new((k * (w + 4)) as i32, (row * (h + 4)) as i32);
+        Rectangle::new(at, Size::new(6 * label.len() as u32 + 4, 12))
+            .into_styled(PrimitiveStyle::with_fill(Rgb565::BLACK))
+            .draw(out)
+            .expect("the frame takes any pixel");
+        Text::with_baseline(
+            &label,
+            at + Point::new(2, 1),
+            MonoTextStyle::new(&FONT_6X10, Rgb565::WHITE),
+            Baseline::Top,
+        )
+        .draw(out)
+        .expect("the frame takes any pixel");
         println!(
             "formats scene={name} format={format} near={near} far={far} visibility_differs={differ} source=rasterizer"
         );

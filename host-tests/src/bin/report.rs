@@ -550,14 +550,51 @@ fn main() {
         .map(|n| n.get())
         .unwrap_or(1);
 
+    // The scene planner's choices (M4, ranked by RAM: no board needed), marked on the plot: each plan's format with
+    // the report's combination of the same strategy (the fast tier for `fast-div`, whose host arithmetic is the same
+    // tier's), else the format's first combination.
+    let plans: Vec<host_tests::plan::Plan> = ["big", "overdraw", "small", "terrain", "torus"]
+        .iter()
+        .map(|s| {
+            let wl = host_tests::plan::workload(s).expect("a standard scene");
+            let core = host_tests::plan::Core::M4;
+            host_tests::plan::plan(
+                &wl,
+                host_tests::plan::Budget {
+                    max_visibility_errors: 0,
+                    depth_ram: core.default_depth_ram(s),
+                    core,
+                },
+            )
+            .expect("the scene plans")
+        })
+        .collect();
+    let mut marks: Vec<Vec<&str>> = vec![vec![]; combos.len()];
+    for p in &plans {
+        let key = if p.strategy == "fast-div" {
+            "fast"
+        } else {
+            p.strategy.as_str()
+        };
+        let same = |c: &&Combo| c.format == p.format;
+        if let Some(k) = combos
+            .iter()
+            .position(|c| same(&c) && c.board_key == Some(key))
+            .or_else(|| combos.iter().position(|c| same(&c)))
+        {
+            marks[k].push(&p.scene);
+        }
+    }
     // plots
     let points: Vec<Point2> = combos
         .iter()
-        .map(|c| Point2 {
+        .zip(&marks)
+        .map(|(c, m)| Point2 {
             x: c.ns_px,
             y: err(c),
             label: format!("{} {}", c.format, c.strategy),
             pareto: c.pareto,
+            mark: (!m.is_empty()).then(|| format!("plan: {}", m.join(", "))),
         })
         .collect();
     pareto_plot(
@@ -621,6 +658,19 @@ fn main() {
         );
     }
     let _ = writeln!(md, "\n![error against run time](pareto.png)\n");
+    let _ = writeln!(md, "## The scene planner's choices\n\nRinged in blue on the plot above: what `cargo run --release -p host-tests --bin plan -- <scene>` (M4, ranked by RAM) takes for each scene, on the report's combination of the same format and tier (a plan without a depth buffer has no depth error to plot). `--measure` ranks by instructions on the board instead; the savings below use it.\n\n```");
+    for p in &plans {
+        let _ = writeln!(md, "{}", p.line());
+    }
+    let _ = writeln!(md, "```\n\n## What a plan saves\n");
+    match std::fs::read_to_string(dir.join("savings.md")) {
+        Ok(t) => {
+            let _ = writeln!(md, "{t}");
+        }
+        Err(_) => {
+            let _ = writeln!(md, "Not measured yet: `python3 boards/tools/savings.py` builds and runs each plan's firmware and the default build on the M4 and M0 boards and writes `report/savings.md`, which this section includes.\n");
+        }
+    }
     let _ = writeln!(md, "## Every combination\n");
     let _ = writeln!(md, "| format | strategy | host ns/px | scenes: max / mean LSB | scenes: max / mean rel. | visibility diffs | coverage diffs | stiff: max LSB | stiff: max rel. | stiff coverage diffs | M4 instr/px | M0 instr/px | Pareto |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for c in &combos {
