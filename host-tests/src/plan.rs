@@ -149,9 +149,12 @@ pub fn workload(name: &str) -> Result<Workload, String> {
             h: HEIGHT,
         });
     }
+    if let Some(path) = name.strip_prefix("obj:") {
+        return obj_workload(std::path::Path::new(path), OBJ_FRAMES);
+    }
     if name != "torus" {
         return Err(format!(
-            "unknown scene {name:?} (big, overdraw, small, terrain, torus)"
+            "unknown scene {name:?} (big, overdraw, small, terrain, torus, obj:<file.obj>)"
         ));
     }
     let cam = torus::camera().map_err(|e| format!("{e:?}"))?;
@@ -173,6 +176,77 @@ pub fn workload(name: &str) -> Result<Workload, String> {
         name: name.into(),
         frames,
         state,
+        w: WIDTH,
+        h: HEIGHT,
+    })
+}
+
+/// Frames of an OBJ scene's camera path.
+pub const OBJ_FRAMES: usize = 8;
+
+/// An OBJ mesh (loaded with `tobj`, every model of the file as one mesh) seen along a camera path: `frames` views
+/// from an eye circling the mesh's bounding sphere (`wraster::mesh::Sphere`: centre `c`, radius `r`) at distance
+/// `3r`, 0.4 rad above the plane `y = c_y`, looking at `c` with `y` up; 60 degrees vertical field of view, aspect
+/// 4:3, `W_near = r` and `W_far = 4.5 r` (every vertex lies between `2r` and `4r` from the eye, and the sphere's
+/// 19.5 degrees fit the 30-degree half field: no triangle needs clipping). Back faces culled: the mesh must be wound
+/// counter-clockwise seen from outside. Its name is `obj-<file stem>`.
+pub fn obj_workload(path: &std::path::Path, frames: usize) -> Result<Workload, String> {
+    use wraster::projection::Camera;
+    use wraster::scenes::{HEIGHT, WIDTH};
+    let (models, _) = tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let (mut pos, mut idx) = (Vec::<[f32; 3]>::new(), Vec::<[u16; 3]>::new());
+    for model in &models {
+        let base = pos.len();
+        pos.extend(
+            model
+                .mesh
+                .positions
+                .chunks_exact(3)
+                .map(|p| [p[0], p[1], p[2]]),
+        );
+        for t in model.mesh.indices.chunks_exact(3) {
+            let k = |i: u32| {
+                u16::try_from(base + i as usize)
+                    .map_err(|_| "more than 65,536 vertices".to_string())
+            };
+            idx.push([k(t[0])?, k(t[1])?, k(t[2])?]);
+        }
+    }
+    let sphere = wraster::mesh::Sphere::enclosing(&pos).map_err(|e| format!("{e:?}"))?;
+    let (c, r) = (sphere.center, sphere.radius);
+    if !(r > 0.0 && r.is_finite()) {
+        return Err(format!("{}: an empty or degenerate mesh", path.display()));
+    }
+    let (d, e) = (3.0 * r, 0.4f32);
+    let mut out = vec![];
+    let mut state = None;
+    for k in 0..frames {
+        let a = 2.0 * core::f32::consts::PI * k as f32 / frames as f32;
+        let eye = [
+            c[0] + d * e.cos() * a.cos(),
+            c[1] + d * e.sin(),
+            c[2] + d * e.cos() * a.sin(),
+        ];
+        let cam = Camera::look_at(
+            eye,
+            c,
+            [0.0, 1.0, 0.0],
+            core::f32::consts::FRAC_PI_3,
+            4.0 / 3.0,
+            r,
+            4.5 * r,
+        )
+        .map_err(|e| format!("{e:?}"))?;
+        let st = cam.render_state().map_err(|e| format!("{e:?}"))?;
+        out.push(screen_tris(&pos, &idx, &cam.matrix(), st, WIDTH, HEIGHT)?);
+        state = Some(st);
+    }
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
+    Ok(Workload {
+        name: format!("obj-{stem}"),
+        frames: out,
+        state: state.ok_or("no frames")?,
         w: WIDTH,
         h: HEIGHT,
     })
@@ -484,10 +558,18 @@ impl Plan {
             "/// Its depth path.\npub const PLAN_KIND: u8 = crate::{kind};"
         )
         .unwrap();
-        let scene = wraster::scenes::Scene::ALL
+        // The boards bake the standard scenes and W4 only: another scene's plan names no scene they can draw.
+        let scene = match wraster::scenes::Scene::ALL
             .iter()
             .position(|x| x.name() == self.scene)
-            .map_or("crate::TORUS_SCENE".to_string(), |k| k.to_string());
+        {
+            Some(k) => k.to_string(),
+            None if self.scene == "torus" => "crate::TORUS_SCENE".to_string(),
+            None => format!(
+                "panic!(\"the boards bake the standard scenes and W4's torus, not {}\")",
+                self.scene
+            ),
+        };
         writeln!(
             s,
             "/// Its scene: the index in `SCENES`, or `TORUS_SCENE`.\npub const PLAN_SCENE: usize = {scene};"
@@ -663,6 +745,17 @@ pub fn board_of(core: Core) -> Option<&'static str> {
 /// `bench` line (`instr_per_frame` for the torus's frames, else `instructions`).
 pub fn measure_on_board(cands: &[Plan], dir: &std::path::Path) -> Result<Vec<f64>, String> {
     std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+    if let Some(p) = cands.iter().find(|p| {
+        p.scene != "torus"
+            && !wraster::scenes::Scene::ALL
+                .iter()
+                .any(|s| s.name() == p.scene)
+    }) {
+        return Err(format!(
+            "--measure runs plans on the boards, which bake the standard scenes and W4's torus, not {}",
+            p.scene
+        ));
+    }
     cands
         .iter()
         .enumerate()

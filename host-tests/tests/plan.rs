@@ -299,3 +299,34 @@ fn measured_ranking_runs_each_candidate_on_its_board() {
         }
     }
 }
+
+/// An OBJ mesh along a camera path (`obj:<file>`: two linked rings seen from 8 places on a circle): where the rings
+/// pass in front of each other, drawing order alone shows the wrong one (the depth-less candidate counts its
+/// errors), so the plan keeps W16 over the W the path draws, with no error; its Rust names no scene the boards
+/// bake, so a board build from it stops with that message, and `--measure` says so too.
+#[test]
+fn an_obj_scene_plans_along_its_camera_path() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/links.obj");
+    let wl = workload(&format!("obj:{path}")).unwrap();
+    assert_eq!((wl.name.as_str(), wl.frames.len()), ("obj-links", 8));
+    let p = plan(&wl, budget(Core::M4, "obj-links")).unwrap();
+    assert!(
+        p.tried.iter().any(|t| t.0 == "none" && t.3 > 100),
+        "{:?}",
+        p.tried
+    );
+    assert_eq!(
+        (p.format.as_str(), p.visibility_errors, p.budget_met),
+        ("W16", 0, true)
+    );
+    let (n, f) = (wl.state.range.near(), wl.state.range.far());
+    assert!(p.near > n && p.far < f && p.near < p.far, "{p:?}");
+    assert!(p
+        .rust("test")
+        .contains("panic!(\"the boards bake the standard scenes"));
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/plans-test/obj");
+    assert!(measure_on_board(&[p], &dir)
+        .unwrap_err()
+        .contains("not obj-links"));
+    assert!(workload("obj:/no/such/file.obj").is_err());
+}

@@ -1,6 +1,7 @@
 //! The scene planner: `cargo run --release -p host-tests --bin plan -- <scene> [--max-visibility-errors N]
-//! [--depth-ram BYTES] [--core m0|m4|rv32] [--out FILE] [--measure]` for `big`, `overdraw`, `small`, `terrain` and `torus` (W4's
-//! 8 frames). Measures the scene against the f64 reference, picks the cheapest build within the budget (default: 0
+//! [--depth-ram BYTES] [--core m0|m4|rv32] [--out FILE] [--measure]` for `big`, `overdraw`, `small`, `terrain`,
+//! `torus` (W4's 8 frames) and `obj:<file.obj>` (a mesh along a camera path: `host_tests::plan::obj_workload`).
+//! Measures the scene against the f64 reference, picks the cheapest build within the budget (default: 0
 //! visibility errors; the core's board's depth RAM; `m4`), writes it as Rust source for a board's build.rs
 //! (default `target/plans/<scene>-<core>.rs`; `PLAN=<file> cargo run --release --features plan` in a board) and
 //! prints, last, `plan scene=.. format=.. strategy=.. near=.. far=.. bands=.. depth_ram=.. features=.. visibility_errors=..`.
@@ -30,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             s => return Err(format!("unexpected argument {s:?}").into()),
         }
     }
-    let scene = scene.ok_or("usage: plan <big|overdraw|small|terrain|torus> [--max-visibility-errors N] [--depth-ram BYTES] [--core m0|m4|rv32] [--out FILE] [--measure]")?;
+    let scene = scene.ok_or("usage: plan <big|overdraw|small|terrain|torus|obj:FILE> [--max-visibility-errors N] [--depth-ram BYTES] [--core m0|m4|rv32] [--out FILE] [--measure]")?;
     let wl = workload(&scene)?;
     let budget = Budget {
         max_visibility_errors: max,
@@ -90,8 +91,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     let out = out.unwrap_or_else(|| {
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join(format!("../target/plans/{scene}-{}.rs", core.name()))
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!(
+            "../target/plans/{}-{}.rs",
+            wl.name,
+            core.name()
+        ))
     });
     if let Some(d) = out.parent() {
         std::fs::create_dir_all(d)?;

@@ -553,7 +553,8 @@ fn main() {
     // The scene planner's choices (M4, ranked by RAM: no board needed), marked on the plot: each plan's format with
     // the report's combination of the same strategy (the fast tier for `fast-div`, whose host arithmetic is the same
     // tier's), else the format's first combination.
-    let plans: Vec<host_tests::plan::Plan> = ["big", "overdraw", "small", "terrain", "torus"]
+    let links = format!("obj:{}/assets/links.obj", env!("CARGO_MANIFEST_DIR"));
+    let plans: Vec<host_tests::plan::Plan> = ["big", "overdraw", "small", "terrain", "torus", &links]
         .iter()
         .map(|s| {
             let wl = host_tests::plan::workload(s).expect("a standard scene");
@@ -658,7 +659,7 @@ fn main() {
         );
     }
     let _ = writeln!(md, "\n![error against run time](pareto.png)\n");
-    let _ = writeln!(md, "## The scene planner's choices\n\nRinged in blue on the plot above: what `cargo run --release -p host-tests --bin plan -- <scene>` (M4, ranked by RAM) takes for each scene, on the report's combination of the same format and tier (a plan without a depth buffer has no depth error to plot). `--measure` ranks by instructions on the board instead; the savings below use it.\n\n```");
+    let _ = writeln!(md, "## The scene planner's choices\n\nRinged in blue on the plot above: what `cargo run --release -p host-tests --bin plan -- <scene>` (M4, ranked by RAM) takes for each scene (and for `obj:host-tests/assets/links.obj`, two linked rings along a camera path), on the report's combination of the same format and tier (a plan without a depth buffer has no depth error to plot). `--measure` ranks by instructions on the board instead; the savings below use it.\n\n```");
     for p in &plans {
         let _ = writeln!(md, "{}", p.line());
     }
