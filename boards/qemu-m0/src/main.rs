@@ -110,8 +110,8 @@ fn main() -> ! {
         & torus::<FastDiv>(COLOR, DEPTH, VERTS, &mut counter)
         & torus::<Exact>(COLOR, DEPTH, VERTS, &mut counter)
         & torus::<PrevPixel>(COLOR, DEPTH, VERTS, &mut counter);
-    // W4's build also measures the bounding-sphere cull (README: leaving work out at run time).
-    #[cfg(not(feature = "size-probe"))]
+    // `--features cull`: W4's build also measures the bounding-sphere cull (README: leaving work out at run time).
+    #[cfg(feature = "cull")]
     let ok = ok
         & wraster_board::cull_line("qemu-m0", "m0", VERTS, &mut counter, |line| {
             hprintln!("{}", line)

@@ -73,8 +73,8 @@ fn main() -> ! {
         & all::<Fast>(COLOR, DEPTH, VERTS, &mut counter)
         & all::<Exact>(COLOR, DEPTH, VERTS, &mut counter)
         & all::<PrevPixel>(COLOR, DEPTH, VERTS, &mut counter);
-    // W4's build also measures the bounding-sphere cull (README: leaving work out at run time).
-    #[cfg(all(feature = "torus", not(feature = "size-probe")))]
+    // `--features cull`: W4's build also measures the bounding-sphere cull (README: leaving work out at run time).
+    #[cfg(feature = "cull")]
     let ok = ok
         & wraster_board::cull_line("qemu-m4", "m4", VERTS, &mut counter, |line| {
             hprintln!("{}", line)

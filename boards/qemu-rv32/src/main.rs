@@ -69,8 +69,8 @@ fn main() -> ! {
         & all::<Fast>(&mut color, &mut depth, &mut verts)
         & all::<Exact>(&mut color, &mut depth, &mut verts)
         & all::<PrevPixel>(&mut color, &mut depth, &mut verts);
-    // W4's build also measures the bounding-sphere cull (README: leaving work out at run time).
-    #[cfg(feature = "torus")]
+    // `--features cull`: W4's build also measures the bounding-sphere cull (README: leaving work out at run time).
+    #[cfg(feature = "cull")]
     let ok = ok
         & wraster_board::cull_line("qemu-rv32", "rv32", &mut verts, &mut Minstret(0), |line| {
             hprintln!("{}", line)
