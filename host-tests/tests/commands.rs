@@ -84,3 +84,27 @@ fn report_writes_its_tables_and_its_line_last() {
         assert!(max_lsb <= 1, "{s}: {max_lsb}");
     }
 }
+
+/// The coarse-bound measurement (`coarse`): its line comes last; what a bound rejects is a subset of what fails the
+/// depth test (each rejected fragment is at or behind everything stored in its region, so `Less` fails it), the
+/// kept bound rejects no more than the exact one, and the whole band no more than rows. On W2 (16 large
+/// triangles over each other) the whole frame and every row always hold some far pixel, so only tiles reject.
+#[test]
+fn coarse_counts_what_a_bound_could_reject() {
+    let out = Command::new(env!("CARGO_BIN_EXE_coarse"))
+        .arg("overdraw")
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let last = text.lines().last().unwrap();
+    assert!(last.starts_with("coarse scene=overdraw "), "{last}");
+    let n = |k: &str| -> u64 { field(last, k).unwrap().parse().unwrap() };
+    // W2's fragments and failing fragments, as the boards count them (README: 248,347, of which 83,797 pass).
+    assert_eq!((n("fragments"), n("failing")), (248_347, 248_347 - 83_797));
+    assert!(n("tile8_kept_rejects") <= n("tile8_rejects") && n("tile8_rejects") <= n("failing"));
+    // A triangle behind the frame's largest code is behind every row's.
+    assert!(n("band_rejects") <= n("row_rejects"));
+    assert_eq!((n("band_rejects"), n("row_rejects")), (0, 0));
+    assert!(n("tile8_kept_rejects") > n("failing") / 2, "{last}");
+}

@@ -119,6 +119,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     ] {
         println!("granularity={name} rejected_fragments={n} ({:.1}% of fragments, {:.1}% of the failing ones)", pct(n), 100.0 * n as f64 / failing.max(1) as f64);
     }
-    println!("coarse scene={scene} fragments={fragments} failing={failing} band_rejects={band} row_rejects={row} tile8_rejects={tile} tile8_kept_rejects={kept}");
+    println!("coarse scene={} fragments={fragments} failing={failing} band_rejects={band} row_rejects={row} tile8_rejects={tile} tile8_kept_rejects={kept}", wl.name);
     Ok(())
 }
