@@ -9,6 +9,19 @@ use host_tests::plan::{
 use host_tests::{have, run_board_env};
 use wraster::{RenderState, Vertex};
 
+/// Whether QEMU is here to run the boards; without it a test fails unless told to skip (`WRASTER_SKIP_FIRMWARE=1`,
+/// as `firmware.rs`).
+fn qemu() -> bool {
+    if have("qemu-system-arm") {
+        return true;
+    }
+    assert!(
+        std::env::var("WRASTER_SKIP_FIRMWARE").is_ok_and(|v| v == "1"),
+        "QEMU (qemu-system-arm) is missing: install it (.ci/run shows how) or set WRASTER_SKIP_FIRMWARE=1"
+    );
+    false
+}
+
 fn budget(core: Core, scene: &str) -> Budget {
     Budget {
         max_visibility_errors: 0,
@@ -181,11 +194,7 @@ fn plans_fit_their_scenes() {
 /// the host's rendering of each plan. Needs QEMU, as `firmware.rs` (`WRASTER_SKIP_FIRMWARE=1` skips knowingly).
 #[test]
 fn boards_built_from_plans_draw_the_hosts_frames() {
-    if !have("qemu-system-arm") {
-        assert!(
-            std::env::var("WRASTER_SKIP_FIRMWARE").is_ok_and(|v| v == "1"),
-            "QEMU (qemu-system-arm) is missing: install it (.ci/run shows how) or set WRASTER_SKIP_FIRMWARE=1"
-        );
+    if !qemu() {
         return;
     }
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/plans-test");
@@ -279,11 +288,7 @@ fn measured_ranking_takes_the_fewest_instructions() {
 /// W1 on both cores. Needs QEMU, as `firmware.rs` (`WRASTER_SKIP_FIRMWARE=1` skips knowingly).
 #[test]
 fn measured_ranking_runs_each_candidate_on_its_board() {
-    if !have("qemu-system-arm") {
-        assert!(
-            std::env::var("WRASTER_SKIP_FIRMWARE").is_ok_and(|v| v == "1"),
-            "QEMU (qemu-system-arm) is missing: install it (.ci/run shows how) or set WRASTER_SKIP_FIRMWARE=1"
-        );
+    if !qemu() {
         return;
     }
     let dir =
