@@ -554,22 +554,23 @@ fn main() {
     // the report's combination of the same strategy (the fast tier for `fast-div`, whose host arithmetic is the same
     // tier's), else the format's first combination.
     let links = format!("obj:{}/assets/links.obj", env!("CARGO_MANIFEST_DIR"));
-    let plans: Vec<host_tests::plan::Plan> = ["big", "overdraw", "small", "terrain", "torus", &links]
-        .iter()
-        .map(|s| {
-            let wl = host_tests::plan::workload(s).expect("a standard scene");
-            let core = host_tests::plan::Core::M4;
-            host_tests::plan::plan(
-                &wl,
-                host_tests::plan::Budget {
-                    max_visibility_errors: 0,
-                    depth_ram: core.default_depth_ram(s),
-                    core,
-                },
-            )
-            .expect("the scene plans")
-        })
-        .collect();
+    let plans: Vec<host_tests::plan::Plan> =
+        ["big", "overdraw", "small", "terrain", "torus", &links]
+            .iter()
+            .map(|s| {
+                let wl = host_tests::plan::workload(s).expect("a standard scene");
+                let core = host_tests::plan::Core::M4;
+                host_tests::plan::plan(
+                    &wl,
+                    host_tests::plan::Budget {
+                        max_visibility_errors: 0,
+                        depth_ram: core.default_depth_ram(s),
+                        core,
+                    },
+                )
+                .expect("the scene plans")
+            })
+            .collect();
     let mut marks: Vec<Vec<&str>> = vec![vec![]; combos.len()];
     for p in &plans {
         let key = if p.strategy == "fast-div" {
