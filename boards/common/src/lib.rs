@@ -778,37 +778,45 @@ pub fn cull_line<C: Counter>(
 ) -> bool {
     use wraster::mesh::Sphere;
     use wraster::scenes::torus;
-    let run = |verts: &mut [Projected], counter: &mut C| -> Result<(u64, u64, u64, bool, bool), Error> {
-        let cam = torus::camera()?;
-        let state = cam.render_state()?;
-        let r = Rasterizer::<wraster::recip::Fast>::new(state);
-        let mesh = Mesh {
-            positions: &TORUS_POSITIONS,
-            indices: &TORUS_INDICES,
-            colors: Colors::PerFace(&TORUS_COLORS),
-        };
-        let vp = Viewport::new(0.0, 0.0, WIDTH as f32, HEIGHT as f32);
-        let size = embedded_graphics_core::geometry::Size::new(WIDTH as u32, HEIGHT as u32);
-        let sphere = Sphere::enclosing(&TORUS_POSITIONS)?;
-        let m_in = cam.model_matrix(&torus::model(0));
-        // The eye is at z = 3 looking at the origin: z = 10 is behind it.
-        let m_out = cam.model_matrix(&(torus::model(0) * wraster::projection::Mat4::translation([0.0, 0.0, 10.0])));
-        let mut mean = |m: &wraster::projection::Mat4| {
-            let mut v = true;
+    let run =
+        |verts: &mut [Projected], counter: &mut C| -> Result<(u64, u64, u64, bool, bool), Error> {
+            let cam = torus::camera()?;
+            let state = cam.render_state()?;
+            let r = Rasterizer::<wraster::recip::Fast>::new(state);
+            let mesh = Mesh {
+                positions: &TORUS_POSITIONS,
+                indices: &TORUS_INDICES,
+                colors: Colors::PerFace(&TORUS_COLORS),
+            };
+            let vp = Viewport::new(0.0, 0.0, WIDTH as f32, HEIGHT as f32);
+            let size = embedded_graphics_core::geometry::Size::new(WIDTH as u32, HEIGHT as u32);
+            let sphere = Sphere::enclosing(&TORUS_POSITIONS)?;
+            let m_in = cam.model_matrix(&torus::model(0));
+            // The eye is at z = 3 looking at the origin: z = 10 is behind it.
+            let m_out = cam.model_matrix(
+                &(torus::model(0) * wraster::projection::Mat4::translation([0.0, 0.0, 10.0])),
+            );
+            let mut mean = |m: &wraster::projection::Mat4| {
+                let mut v = true;
+                counter.start();
+                for _ in 0..64 {
+                    v &= core::hint::black_box(&sphere).visible(
+                        core::hint::black_box(m),
+                        &vp,
+                        size,
+                        &state.range,
+                    );
+                }
+                (counter.stop() / 64, v)
+            };
+            let (i_in, v_in) = mean(&m_in);
+            let (i_out, v_out) = mean(&m_out);
             counter.start();
-            for _ in 0..64 {
-                v &= core::hint::black_box(&sphere).visible(core::hint::black_box(m), &vp, size, &state.range);
-            }
-            (counter.stop() / 64, v)
+            let f = r.transform_mesh(&mesh, &m_in, &vp, verts);
+            let t = counter.stop();
+            f?;
+            Ok((i_in, i_out, t, v_in, !v_out))
         };
-        let (i_in, v_in) = mean(&m_in);
-        let (i_out, v_out) = mean(&m_out);
-        counter.start();
-        let f = r.transform_mesh(&mesh, &m_in, &vp, verts);
-        let t = counter.stop();
-        f?;
-        Ok((i_in, i_out, t, v_in, !v_out))
-    };
     match run(verts, counter) {
         Ok((i_in, i_out, t, kept, culled)) => {
             print(format_args!(
