@@ -421,7 +421,9 @@ impl Sphere {
     /// from the Gram products of `M`'s `x`, `y` and `w` columns, and the test is compared squared (no square root).
     /// Rounding: `L` errs by under `2^-20` of `T`, the sum of its terms' magnitudes, and `|a|^2` by under `2^-20` of
     /// `B`, its terms' magnitudes; the test subtracts `2^-16 T` from `-L` and adds `2^-20 B` to `|a|^2`, so a mesh is
-    /// culled only when the exact test would cull it. A NaN or overflow anywhere gives `true`.
+    /// culled only when the exact test would cull it. A NaN or overflow anywhere gives `true`. A viewport the draws
+    /// refuse (a clip width or height that is not positive: `transform_mesh` returns [`Error::NonFinite`]) may give
+    /// either answer.
     pub fn visible(
         &self,
         m: &Mat4,
