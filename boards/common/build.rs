@@ -151,6 +151,11 @@ fn plans() {
     writeln!(s, "/// Whether a plan draws W4's torus (its vertices need RAM).\npub const HAS_TORUS: bool = false{};", torus.iter().map(|t| format!(" || {t}")).collect::<String>()).unwrap();
     writeln!(
         s,
+        "/// The `u16` words of depth storage a board gives the plans.\npub const DEPTH_LEN: usize = MAX_DEPTH_RAM.div_ceil(2);\n/// The transformed vertices a board stores for the plans (the torus's, or none).\npub const VERTS_LEN: usize = if HAS_TORUS {{ wraster::scenes::torus::VERTICES }} else {{ 0 }};"
+    )
+    .unwrap();
+    writeln!(
+        s,
         "/// Runs every plan, printing its `bench` line; `false` when one failed.\n#[allow(unused_variables, unused_mut, clippy::let_and_return)]\npub fn run_all_plans<C: crate::Counter>(board: &str, core: &str, color: &mut [u16], depth: &mut [u16], verts: &mut [wraster::mesh::Projected], counter: &mut C, print: &mut dyn FnMut(core::fmt::Arguments<'_>)) -> bool {{\n    let mut ok = true;\n{calls}    ok\n}}"
     )
     .unwrap();

@@ -17,7 +17,7 @@ use embedded_graphics_core::primitives::Rectangle;
 use embedded_graphics_core::Pixel;
 use wraster::clip::Viewport;
 use wraster::format::W16;
-use wraster::mesh::{Colors, Mesh, Projected};
+use wraster::mesh::{Colors, Mesh, MeshFrame, Projected};
 use wraster::recip::SpanRecip;
 use wraster::{Codec, DepthBuffer, Error, Packed, Rasterizer, RenderState, Stats, Vertex};
 
@@ -480,30 +480,17 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE:
             let frame = frame?;
             let (i, b) = if KIND == LEAN_W16 {
                 // W16: the mesh path itself (binning by rows, its own cull), as `run_torus` draws.
-                let mut bands = 0;
-                let mut instructions = 0;
-                let w = WIDTH as usize;
-                let mut y0 = 0u16;
-                while y0 < HEIGHT {
-                    let h = plan.band_rows.min(HEIGHT - y0);
-                    let n = w * h as usize;
-                    let (color, depth) = (&mut color[..n], &mut depth[..n]);
-                    color.fill(0);
-                    let mut buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
-                    buf.clear();
-                    let mut band = Band::new(color, y0 as i32);
-                    counter.start();
-                    let s = r.draw_mesh_frame(&mut band, &mut buf, &frame);
-                    instructions += counter.stop();
-                    stats += s?;
-                    for row in 0..h as usize {
-                        hash.words(&band.px[row * w..(row + 1) * w]);
-                        hash.words(&buf.data()[row * w..(row + 1) * w]);
-                    }
-                    bands += 1;
-                    y0 += h;
-                }
-                (instructions, bands)
+                mesh_frame_in_bands(
+                    &mut r,
+                    &frame,
+                    plan.band_rows,
+                    color,
+                    depth,
+                    counter,
+                    &mut stats,
+                    &mut hash,
+                    &mut |_, _| {},
+                )?
             } else {
                 let v = frame.vertices();
                 run_planned_tris::<F, R, C, KIND>(
@@ -667,6 +654,48 @@ pub fn run_torus<R: SpanRecip, C: Counter>(
     )
 }
 
+/// One transformed mesh frame drawn band by band (`band_h` rows, the W16 depth cleared per band) through
+/// `Rasterizer::draw_mesh_frame`: each band hashed (its colours, then its depths, row by row) and handed to
+/// `on_band` (first row, pixels). Returns the draws' instructions (not the clears or the hash) and the bands.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn mesh_frame_in_bands<R: SpanRecip, C: Counter>(
+    r: &mut Rasterizer<R>,
+    frame: &MeshFrame<'_, Rgb565>,
+    band_h: u16,
+    color: &mut [u16],
+    depth: &mut [u16],
+    counter: &mut C,
+    stats: &mut Stats,
+    hash: &mut Fnv,
+    on_band: &mut impl FnMut(u16, &[u16]),
+) -> Result<(u64, u32), Error> {
+    let (mut instructions, mut bands) = (0u64, 0u32);
+    let w = WIDTH as usize;
+    let mut y0 = 0u16;
+    while y0 < HEIGHT {
+        let h = band_h.min(HEIGHT - y0);
+        let n = w * h as usize;
+        let (color, depth) = (&mut color[..n], &mut depth[..n]);
+        color.fill(0);
+        let mut buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+        buf.clear();
+        let mut band = Band::new(color, y0 as i32);
+        counter.start();
+        let s = r.draw_mesh_frame(&mut band, &mut buf, frame);
+        instructions += counter.stop();
+        *stats += s?;
+        for row in 0..h as usize {
+            hash.words(&band.px[row * w..(row + 1) * w]);
+            hash.words(&buf.data()[row * w..(row + 1) * w]);
+        }
+        on_band(y0, band.px);
+        bands += 1;
+        y0 += h;
+    }
+    Ok((instructions, bands))
+}
+
 /// [`run_torus`] for frames `frames` (frame `k` rotates by `k` steps; any `k`), handing each finished band (first
 /// row, RGB565 pixels) to `on_band`, as a display driver wants it.
 pub fn run_torus_with<R: SpanRecip, C: Counter>(
@@ -696,28 +725,19 @@ pub fn run_torus_with<R: SpanRecip, C: Counter>(
         let frame = r.transform_mesh(&mesh, &m, &vp, verts);
         instructions += counter.stop();
         let frame = frame?;
-        let mut y0 = 0u16;
-        while y0 < HEIGHT {
-            let h = band_h.min(HEIGHT - y0);
-            let n = WIDTH as usize * h as usize;
-            let (color, depth) = (&mut color[..n], &mut depth[..n]);
-            color.fill(0);
-            let mut buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
-            buf.clear();
-            let mut band = Band::new(color, y0 as i32);
-            counter.start();
-            let s = r.draw_mesh_frame(&mut band, &mut buf, &frame);
-            instructions += counter.stop();
-            stats += s?;
-            let w = WIDTH as usize;
-            for row in 0..h as usize {
-                hash.words(&band.px[row * w..(row + 1) * w]);
-                hash.words(&buf.data()[row * w..(row + 1) * w]);
-            }
-            on_band(y0, band.px);
-            bands += 1;
-            y0 += h;
-        }
+        let (i, b) = mesh_frame_in_bands(
+            &mut r,
+            &frame,
+            band_h,
+            color,
+            depth,
+            counter,
+            &mut stats,
+            &mut hash,
+            &mut on_band,
+        )?;
+        instructions += i;
+        bands += b;
     }
     Ok(Run {
         scene: "torus",

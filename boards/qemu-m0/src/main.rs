@@ -165,19 +165,17 @@ mod plan_buffers {
         plans::MAX_BAND_ROWS
     };
     pub const COLOR_LEN: usize = WIDTH as usize * ROWS;
-    pub const DEPTH_LEN: usize = plans::MAX_DEPTH_RAM.div_ceil(2);
-    pub const VERTS_LEN: usize = if plans::HAS_TORUS {
-        wraster::scenes::torus::VERTICES
-    } else {
-        0
-    };
     const _: () = assert!(
         plans::COUNT > 0,
         "--features plan needs PLAN=<file>,... (host-tests' plan binary writes them)"
     );
 }
 #[cfg(feature = "plan")]
-use {plan_buffers::*, wraster::mesh::Projected, wraster_board::plans};
+use {
+    plan_buffers::COLOR_LEN,
+    wraster::mesh::Projected,
+    wraster_board::plans::{self, DEPTH_LEN, VERTS_LEN},
+};
 
 #[cfg(feature = "plan")]
 #[entry]

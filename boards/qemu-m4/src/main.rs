@@ -102,22 +102,12 @@ fn main() -> ! {
 /// buffer is sized from the plans (none when no plan keeps depth) and the torus's vertex store is there only when a
 /// plan draws it, so `.bss` shows what a plan saves.
 #[cfg(feature = "plan")]
-mod plan_buffers {
-    use wraster_board::plans;
-    pub const DEPTH_LEN: usize = plans::MAX_DEPTH_RAM.div_ceil(2);
-    pub const VERTS_LEN: usize = if plans::HAS_TORUS {
-        wraster::scenes::torus::VERTICES
-    } else {
-        0
-    };
-    const _: () = assert!(
-        plans::COUNT > 0,
-        "--features plan needs PLAN=<file>,... (host-tests' plan binary writes them)"
-    );
-}
-
+use wraster_board::plans::{DEPTH_LEN, VERTS_LEN};
 #[cfg(feature = "plan")]
-use plan_buffers::{DEPTH_LEN, VERTS_LEN};
+const _: () = assert!(
+    wraster_board::plans::COUNT > 0,
+    "--features plan needs PLAN=<file>,... (host-tests' plan binary writes them)"
+);
 
 #[cfg(feature = "plan")]
 #[entry]
