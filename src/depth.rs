@@ -9,12 +9,40 @@ pub const W16_FAR: u16 = u16::MAX;
 /// A borrowed W16 buffer covering `height` rows of a frame `width` pixels wide, from frame row `y0`
 /// (a whole frame when `y0 = 0` and `height` is the frame's height; a band otherwise).
 /// Element `(x, y)` of the frame is at `(y - y0) * width + x`.
+///
+/// With feature `coarse`, a buffer may also keep a coarse bound ([`DepthBuffer::with_bound`]): for each aligned
+/// 8-pixel segment of each row, a code at least as large as every code stored in it. The fast tier's W16 span
+/// ([`crate::recip::Fast`], `Less`) rejects a whole segment whose nearest pixel is at or behind its bound before any
+/// per-pixel work.
 #[derive(Debug)]
 pub struct DepthBuffer<'a> {
     data: &'a mut [u16],
     width: u16,
     height: u16,
     y0: i32,
+    #[cfg(feature = "coarse")]
+    bound: Bound<'a>,
+}
+
+/// The coarse bound of a [`DepthBuffer`] (feature `coarse`): one code per aligned 8-pixel row segment, at least the
+/// largest code stored in the segment while `valid`. Empty when the buffer keeps none.
+#[cfg(feature = "coarse")]
+#[derive(Debug)]
+struct Bound<'a> {
+    seg: &'a mut [u16],
+    /// False after a draw that may raise a stored code (a comparison other than `Less`, `LessEqual`, `Equal` or
+    /// `Never` with depth write): the bound is then unused until [`DepthBuffer::clear`].
+    valid: bool,
+}
+
+/// Pixels per segment of the coarse bound.
+pub(crate) const SEGMENT: usize = 8;
+
+/// The length of the coarse bound of a `width x height` buffer (feature `coarse`): one `u16` per aligned 8-pixel
+/// segment of each row, `ceil(width / 8) * height` (an eighth of the depth buffer's RAM).
+#[cfg(feature = "coarse")]
+pub const fn bound_len(width: usize, height: usize) -> usize {
+    width.div_ceil(SEGMENT) * height
 }
 
 impl<'a> DepthBuffer<'a> {
@@ -37,12 +65,54 @@ impl<'a> DepthBuffer<'a> {
             width,
             height,
             y0,
+            #[cfg(feature = "coarse")]
+            bound: Bound {
+                seg: &mut [],
+                valid: false,
+            },
         })
     }
 
-    /// Sets every element to the far plane.
+    /// Keeps a coarse bound in `seg` (feature `coarse`), whose length must be [`bound_len`]`(width, height)`. It
+    /// starts at the far code, which bounds any content; [`DepthBuffer::clear`] resets it, and the W16 draws lower it
+    /// as they write. The frames and codes are the same with and without it: it only skips work.
+    ///
+    /// ```
+    /// use wraster::{bound_len, DepthBuffer};
+    /// let mut data = [0u16; 64 * 16];
+    /// let mut seg = [0u16; bound_len(64, 16)];
+    /// let mut depth = DepthBuffer::new(&mut data, 64, 16)?.with_bound(&mut seg)?;
+    /// depth.clear();
+    /// # Ok::<(), wraster::Error>(())
+    /// ```
+    #[cfg(feature = "coarse")]
+    pub fn with_bound(mut self, seg: &'a mut [u16]) -> Result<Self, Error> {
+        let expected = bound_len(self.width as usize, self.height as usize);
+        if seg.len() != expected {
+            return Err(Error::BufferSize {
+                expected,
+                actual: seg.len(),
+            });
+        }
+        seg.fill(W16_FAR);
+        self.bound = Bound { seg, valid: true };
+        Ok(self)
+    }
+
+    /// The coarse bound, one code per aligned 8-pixel segment of each row, if the buffer keeps one and it is in use.
+    #[cfg(feature = "coarse")]
+    pub fn bound(&self) -> Option<&[u16]> {
+        (self.bound.valid && !self.bound.seg.is_empty()).then_some(&*self.bound.seg)
+    }
+
+    /// Sets every element to the far plane (and the coarse bound with it).
     pub fn clear(&mut self) {
         self.data.fill(W16_FAR);
+        #[cfg(feature = "coarse")]
+        {
+            self.bound.seg.fill(W16_FAR);
+            self.bound.valid = true;
+        }
     }
 
     /// Frame width in pixels.
@@ -74,6 +144,40 @@ impl<'a> DepthBuffer<'a> {
         let r = (y - self.y0) as usize * self.width as usize;
         &mut self.data[r..r + self.width as usize]
     }
+
+    /// A draw with `cmp` (and depth write `write`) may raise stored codes: stop using the coarse bound until the
+    /// next clear.
+    #[inline(always)]
+    pub(crate) fn note_compare(&mut self, cmp: crate::Compare, write: bool) {
+        #[cfg(feature = "coarse")]
+        {
+            use crate::Compare::*;
+            if write && matches!(cmp, Greater | GreaterEqual | NotEqual | Always) {
+                self.bound.valid = false;
+            }
+        }
+        #[cfg(not(feature = "coarse"))]
+        let _ = (cmp, write);
+    }
+
+    /// Row `y` and, if the buffer keeps a coarse bound in use, that row's segments.
+    #[cfg(feature = "coarse")]
+    #[inline]
+    pub(crate) fn row_and_bound(&mut self, y: i32) -> (&mut [u16], &mut [u16]) {
+        let r = (y - self.y0) as usize;
+        let w = self.width as usize;
+        let row = &mut self.data[r * w..(r + 1) * w];
+        let segs = w.div_ceil(SEGMENT);
+        let seg = if self.bound.valid {
+            self.bound
+                .seg
+                .get_mut(r * segs..(r + 1) * segs)
+                .unwrap_or_default()
+        } else {
+            &mut []
+        };
+        (row, seg)
+    }
 }
 
 /// Owned storage for a `W x H` buffer (a band when `H` is less than the frame's height).
@@ -104,6 +208,11 @@ impl<const W: usize, const H: usize> DepthStore<W, H> {
             width: W as u16,
             height: H as u16,
             y0,
+            #[cfg(feature = "coarse")]
+            bound: Bound {
+                seg: &mut [],
+                valid: false,
+            },
         }
     }
     /// A view of it as a whole frame.

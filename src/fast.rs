@@ -257,6 +257,7 @@ fn chains<const UP: bool>(dv: i64) -> bool {
 
 /// Draws one `Less`, depth-write span whose every pixel is in range and whose step is tame (`|dt| <= T_min / 4`).
 /// `t0` is the first pixel's `T` (`t 2^frac`), `dt` the step. Fails are reported to `runs`, passing runs filled.
+/// `seg` is the row's coarse bound (feature `coarse`; empty for none) and `x0` the frame column of `row[0]`.
 #[inline(always)]
 pub(crate) fn span<S: FreshSeed, D: DrawTarget>(
     row: &mut [u16],
@@ -264,7 +265,28 @@ pub(crate) fn span<S: FreshSeed, D: DrawTarget>(
     dt: i64,
     frac: u32,
     runs: &mut Runs<'_, D>,
+    seg: &mut [u16],
+    x0: usize,
 ) -> Result<(), Error> {
+    #[cfg(feature = "coarse")]
+    if !seg.is_empty() {
+        return span_as::<S, D, true>(row, t0, dt, frac, runs, seg, x0);
+    }
+    span_as::<S, D, false>(row, t0, dt, frac, runs, seg, x0)
+}
+
+/// [`span`], with the coarse bound's test (`COARSE`) or without.
+#[inline(always)]
+fn span_as<S: FreshSeed, D: DrawTarget, const COARSE: bool>(
+    row: &mut [u16],
+    t0: u64,
+    dt: i64,
+    frac: u32,
+    runs: &mut Runs<'_, D>,
+    seg: &mut [u16],
+    x0: usize,
+) -> Result<(), Error> {
+    let c = Coarse { seg, x0 };
     // T normalised to [2^62, 2^63), then V = T + T/65535 (error below 4 units of 2^62).
     let l0 = t0.leading_zeros() as i32 - 1;
     let tn = t0 << l0;
@@ -277,30 +299,33 @@ pub(crate) fn span<S: FreshSeed, D: DrawTarget>(
         } else {
             (v, dv, l0)
         };
-        walk::<true, S, D>(row, v, dv, lz, frac, runs)
+        walk::<true, S, D, COARSE>(row, v, dv, lz, frac, runs, c)
     } else {
         let (v, dv, lz) = if v >> 63 == 0 {
             (v << 1, dv << 1, l0 + 1)
         } else {
             (v, dv, l0)
         };
-        walk::<false, S, D>(row, v, dv, lz, frac, runs)
+        walk::<false, S, D, COARSE>(row, v, dv, lz, frac, runs, c)
     }
 }
 
 /// The pixels of a span, binade by binade. State between pixels: in a passing run (`x`, `dx` current) or not.
 #[inline(always)]
-fn walk<const UP: bool, S: FreshSeed, D: DrawTarget>(
+fn walk<const UP: bool, S: FreshSeed, D: DrawTarget, const COARSE: bool>(
     row: &mut [u16],
     mut v: u64,
     mut dv: i64,
     mut lz: i32,
     frac: u32,
     runs: &mut Runs<'_, D>,
+    mut coarse: Coarse<'_>,
 ) -> Result<(), Error> {
     let n = row.len();
     let (mut x, mut dx) = (0i32, 0i32);
     let mut in_run = false;
+    // With `COARSE`: the first pixel of the current passing run.
+    let mut run_from = 0usize;
     let mut k = 0usize;
     let crossed = left_binade::<UP>;
     'bins: loop {
@@ -338,6 +363,9 @@ fn walk<const UP: bool, S: FreshSeed, D: DrawTarget>(
                 if failed {
                     // pixel k fails: close the run before it
                     in_run = false;
+                    if COARSE {
+                        coarse.lower(row, run_from, k);
+                    }
                     runs.fail(k)?;
                     k += 1;
                     v = v.wrapping_add(dv as u64);
@@ -349,7 +377,8 @@ fn walk<const UP: bool, S: FreshSeed, D: DrawTarget>(
             } else {
                 // Not in a run: the prefilter alone, until a pixel it cannot rule out.
                 let start = k;
-                let (skipped, vv, end) = skip_run::<UP>(&row[k..], v, dv as u64, b.lim);
+                let (skipped, vv, end) =
+                    skip_run::<UP, COARSE>(&row[k..], v, dv as u64, b.lim, &coarse, k);
                 v = vv;
                 k += skipped;
                 let (maybe, left) = (end == End::Fail, end == End::Binade);
@@ -369,6 +398,7 @@ fn walk<const UP: bool, S: FreshSeed, D: DrawTarget>(
                 if c < row[k] {
                     row[k] = c;
                     in_run = true;
+                    run_from = k;
                 } else {
                     runs.fail(k)?;
                 }
@@ -380,6 +410,9 @@ fn walk<const UP: bool, S: FreshSeed, D: DrawTarget>(
                 }
             }
         }
+    }
+    if COARSE && in_run {
+        coarse.lower(row, run_from, n);
     }
     Ok(())
 }
@@ -484,7 +517,7 @@ fn by_65535_signed(x: i64) -> i64 {
 
 /// How a passing run ended: at a failing pixel (not drawn, not stepped past), with `tau` leaving its binade (past
 /// the last pixel drawn), or at the end of the row.
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum End {
     Fail,
     Binade,
@@ -500,22 +533,133 @@ struct ChainEnd {
     end: End,
 }
 
-/// The prefilter alone from `row[0]`, out of line like the runs: pixels whose stored code rules them out
-/// ([`ruled_out`] with the binade's limit `lim`) are skipped. Returns the pixels skipped, `v` after them, and how it
-/// ended: at a pixel the prefilter cannot rule out (`End::Fail`, not stepped past), with `tau` leaving its binade,
-/// or at the end of the row.
+/// A row's coarse bound (feature `coarse`): `seg[i]` is at least every code stored in frame columns
+/// `8 i .. 8 i + 8`; `x0` is the frame column of the span's first pixel.
+pub(crate) struct Coarse<'a> {
+    seg: &'a mut [u16],
+    x0: usize,
+}
+
+impl Coarse<'_> {
+    /// Span pixels `a..b` were all just written by one passing run: lower the bound of each aligned segment they
+    /// cover whole to one above the larger of its two end codes. That bounds all eight: the exact codes along a
+    /// span are monotone (W is, on a line in screen space), and each computed code is within
+    /// `65535 FAST_MAX_REL_ERROR < 2^-11.4` of its exact value, so a middle code `round(y_m)` with
+    /// `y_m < y_end + 2^-10.4` is at most one above the larger end's.
+    #[inline(always)]
+    fn lower(&mut self, row: &[u16], a: usize, b: usize) {
+        const SEG: usize = crate::depth::SEGMENT;
+        let mut s = a + (SEG - (self.x0 + a) % SEG) % SEG;
+        while s + SEG <= b {
+            if let (Some(px), Some(g)) =
+                (row.get(s..s + SEG), self.seg.get_mut((self.x0 + s) / SEG))
+            {
+                let top = px[0].max(px[SEG - 1]).saturating_add(1);
+                *g = (*g).min(top);
+            }
+            s += SEG;
+        }
+    }
+}
+
+/// The prefilter alone from `row[0]` (span pixel `k0`), out of line like the runs: pixels whose stored code rules
+/// them out ([`ruled_out`] with the binade's limit `lim`) are skipped. Returns the pixels skipped, `v` after them,
+/// and how it ended: at a pixel the prefilter cannot rule out (`End::Fail`, not stepped past), with `tau` leaving
+/// its binade, or at the end of the row.
+///
+/// With `COARSE`, an aligned 8-pixel segment wholly in the span and in the binade is first tested as a whole: its
+/// largest `tau` against the segment's bound `B`. `ruled_out(tau_max, B)` implies `ruled_out(tau_i, s_i)` for each
+/// of its pixels (`tau_i <= tau_max` and `s_i <= B`, and the test is monotone in both), so the segment is skipped in
+/// one step exactly when the per-pixel loop would skip all 8 pixels, with the same `v` after them (eight wrapping
+/// adds of `dv` are one add of `8 dv`): the frames are the same with the bound and without it.
 #[inline(never)]
-fn skip_run<const UP: bool>(row: &[u16], mut v: u64, dv: u64, lim: u32) -> (usize, u64, End) {
-    for (k, &stored) in row.iter().enumerate() {
+fn skip_run<const UP: bool, const COARSE: bool>(
+    row: &[u16],
+    mut v: u64,
+    dv: u64,
+    lim: u32,
+    coarse: &Coarse<'_>,
+    k0: usize,
+) -> (usize, u64, End) {
+    const SEG: usize = crate::depth::SEGMENT;
+    let n = row.len();
+    if !COARSE {
+        for (k, &stored) in row.iter().enumerate() {
+            if !ruled_out((v >> 32) as u32, stored, lim) {
+                return (k, v, End::Fail);
+            }
+            v = v.wrapping_add(dv);
+            if left_binade::<UP>(v) {
+                return (k + 1, v, End::Binade);
+            }
+        }
+        return (n, v, End::Row);
+    }
+    // Pixel by pixel up to the first aligned segment.
+    let x0 = coarse.x0 + k0;
+    let mut k = ((SEG - x0 % SEG) % SEG).min(n);
+    v = match pixels::<UP>(row, 0, k, v, dv, lim) {
+        Ok(v) => v,
+        Err(end) => return end,
+    };
+    // tau rises along the span upward, falls downward: a segment's largest is at its last pixel or its first. The
+    // last is on this binade when `7 |dv|` is below the room left in it (`|dv| >= 2^61` leaves the binade, `2^62`
+    // wide, within 7 steps; below it `7 |dv|` fits in 64 bits).
+    let mag = if UP { dv } else { dv.wrapping_neg() };
+    let seven = (mag << 3).wrapping_sub(mag);
+    let steep = mag >= 1 << 61;
+    let mut seg = coarse.seg.get((x0 + k) / SEG..).unwrap_or_default().iter();
+    while k + SEG <= n {
+        let bound = seg.next().copied().unwrap_or(u16::MAX);
+        let room = if UP {
+            (1u64 << 63).wrapping_sub(v)
+        } else {
+            v.wrapping_sub(1u64 << 63)
+        };
+        if !steep && (if UP { seven < room } else { seven <= room }) {
+            let last = if UP { v + seven } else { v - seven };
+            if ruled_out(((if UP { last } else { v }) >> 32) as u32, bound, lim) {
+                k += SEG;
+                v = last.wrapping_add(dv);
+                if left_binade::<UP>(v) {
+                    return (k, v, End::Binade);
+                }
+                continue;
+            }
+        }
+        v = match pixels::<UP>(row, k, k + SEG, v, dv, lim) {
+            Ok(v) => v,
+            Err(end) => return end,
+        };
+        k += SEG;
+    }
+    match pixels::<UP>(row, k, n, v, dv, lim) {
+        Ok(v) => (n, v, End::Row),
+        Err(end) => end,
+    }
+}
+
+/// The prefilter on `row[a..b]` (the coarse path of [`skip_run`]): `v` after them, or how it ended, with the pixels
+/// skipped from `row[0]`.
+#[inline(always)]
+fn pixels<const UP: bool>(
+    row: &[u16],
+    a: usize,
+    b: usize,
+    mut v: u64,
+    dv: u64,
+    lim: u32,
+) -> Result<u64, (usize, u64, End)> {
+    for (k, &stored) in row.get(a..b).unwrap_or_default().iter().enumerate() {
         if !ruled_out((v >> 32) as u32, stored, lim) {
-            return (k, v, End::Fail);
+            return Err((a + k, v, End::Fail));
         }
         v = v.wrapping_add(dv);
         if left_binade::<UP>(v) {
-            return (k + 1, v, End::Binade);
+            return Err((a + k + 1, v, End::Binade));
         }
     }
-    (row.len(), v, End::Row)
+    Ok(v)
 }
 
 /// The passing run from `row[0]` with a fresh reciprocal per pixel: its own function, so that its few live values
@@ -849,6 +993,73 @@ mod tests {
                 "{sa} {sb}"
             );
         }
+    }
+
+    /// With a valid coarse bound (each segment's at least its largest stored code), the prefilter with the bound ends
+    /// where the per-pixel one does, with the same `v`: on random rows, both directions, spans starting anywhere in
+    /// a segment, bounds exact or above the largest code; and it does skip whole segments (the test is not vacuous).
+    #[test]
+    fn the_coarse_prefilter_ends_where_the_per_pixel_one_does() {
+        fn check<const UP: bool>(state: &mut u64) -> (u32, u32) {
+            let frac = 40 + (rnd(state) % 16) as u32;
+            let lz = (rnd(state) % 8) as i32;
+            let b = Bin::new::<UP>(frac, lz);
+            let n = 1 + (rnd(state) % 60) as usize;
+            let x0 = (rnd(state) % 40) as usize;
+            let v = if UP {
+                (1u64 << 62) | (rnd(state) >> 2 >> (rnd(state) % 8))
+            } else {
+                (1u64 << 63) | (rnd(state) >> 1)
+            };
+            // Steps up to a quarter of `v` (a tame span), steep ones that leave the binade within a segment too.
+            let mag = ((rnd(state) >> (2 + rnd(state) % 50)).min(v / 4)) as i64;
+            let dv = (if UP { mag } else { -mag }) as u64;
+            // Stored codes near each pixel's ruled-out boundary `lim / A` (where the per-pixel test decides),
+            // mostly just below it (ruled out), one in 40 above.
+            let row: std::vec::Vec<u16> = (0..n)
+                .map(|k| {
+                    let vk = v.wrapping_add(dv.wrapping_mul(k as u64));
+                    let edge = (b.lim / ((vk >> 49) as u32).max(1)).min(65535) as i64;
+                    let d = if rnd(state) % 40 == 0 {
+                        1 + (rnd(state) % 8) as i64
+                    } else {
+                        -((rnd(state) % 4) as i64)
+                    };
+                    (edge + d).clamp(0, 65535) as u16
+                })
+                .collect();
+            let segs = (x0 + n).div_ceil(8);
+            let mut seg = std::vec![0u16; segs];
+            for (i, bnd) in seg.iter_mut().enumerate() {
+                let lo = (i * 8).max(x0) - x0;
+                let hi = ((i + 1) * 8).min(x0 + n).saturating_sub(x0);
+                let max = row[lo.min(hi)..hi].iter().copied().max().unwrap_or(0);
+                *bnd = max.saturating_add((rnd(state) % 3) as u16 * (rnd(state) % 4) as u16);
+            }
+            let c = Coarse { seg: &mut seg, x0 };
+            let k0 = (rnd(state) % 3) as usize;
+            let k0 = k0.min(n - 1);
+            let plain = skip_run::<UP, false>(&row[k0..], v, dv, b.lim, &c, k0);
+            let coarse = skip_run::<UP, true>(&row[k0..], v, dv, b.lim, &c, k0);
+            assert!(
+                plain.0 == coarse.0 && plain.1 == coarse.1 && plain.2 == coarse.2,
+                "up {UP} {plain:?} {coarse:?}"
+            );
+            // Whether a whole aligned segment in the span was skipped (every pixel ruled out).
+            let skipped_whole = (0..plain.0).any(|k| (x0 + k0 + k) % 8 == 0 && k + 8 <= plain.0);
+            (1, u32::from(skipped_whole))
+        }
+        let mut state = 0xC0A5_E000_0000_0001_u64;
+        let (mut runs, mut whole) = (0, 0);
+        for _ in 0..100_000 {
+            let (a, b) = check::<true>(&mut state);
+            let (c, d) = check::<false>(&mut state);
+            (runs, whole) = (runs + a + c, whole + b + d);
+        }
+        assert!(
+            whole > runs / 20,
+            "{whole} of {runs} runs skipped a whole segment"
+        );
     }
 
     /// The prefilter never rules out a pixel whose computed code is below the stored one: for random `tau` on a

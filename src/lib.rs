@@ -134,6 +134,8 @@ pub mod scenes;
 mod small;
 mod state;
 
+#[cfg(feature = "coarse")]
+pub use depth::bound_len;
 pub use depth::{DepthBuffer, DepthStore, W16_FAR};
 pub use error::Error;
 pub use input::{FixedVertex, VertexInput};

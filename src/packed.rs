@@ -426,14 +426,7 @@ impl<R: WSpan> Rasterizer<R> {
                 let n = (hi - lo) as usize;
                 let off = lo as i64 - w.geom.i_ref;
                 let t0 = w.t.at(off) as u64;
-                let mut runs = Runs {
-                    target,
-                    lo,
-                    j,
-                    color,
-                    start: 0,
-                    fails: 0,
-                };
+                let mut runs = Runs::new(target, lo, j, color);
                 if let (Some(buf), true) = (depth.as_deref_mut(), res.mode != DepthMode::Off) {
                     let row = buf.row_mut(j, lo, hi);
                     let z0 = lin.map_or(0, |p| p.at(off));

@@ -413,6 +413,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         D::Color: PixelColor,
     {
         let (cmp, write) = self.w16_test()?;
+        depth.note_compare(cmp, write);
         let mut s = self.setup(v)?;
         // Only for a triangle with rows in the buffer (a band's draws include triangles that only come near it):
         // one that has none draws nothing either way, and both paths find that before they look at `fast_t`.
@@ -444,15 +445,12 @@ impl<R: SpanRecip> Rasterizer<R> {
         for j in w.geom.j0..=w.j1 {
             if let Some((lo, hi)) = w.row(depth.width()) {
                 let t = w.t.at(lo as i64 - w.geom.i_ref) as u64;
-                let row = &mut depth.row_mut(j)[lo as usize..hi as usize];
-                let mut runs = Runs {
-                    target,
-                    lo,
-                    j,
-                    color,
-                    start: 0,
-                    fails: 0,
-                };
+                #[cfg(feature = "coarse")]
+                let (row, seg) = depth.row_and_bound(j);
+                #[cfg(not(feature = "coarse"))]
+                let (row, seg) = (depth.row_mut(j), &mut [][..]);
+                let row = &mut row[lo as usize..hi as usize];
+                let mut runs = Runs::new(target, lo, j, color);
                 span(
                     &mut self.recip,
                     row,
@@ -462,6 +460,7 @@ impl<R: SpanRecip> Rasterizer<R> {
                     cmp,
                     write,
                     &mut runs,
+                    seg,
                 )?;
                 stats.fragments += (hi - lo) as u32;
                 stats.written += (hi - lo) as u32 - runs.fails;
@@ -486,6 +485,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         D::Color: PixelColor + From<Rgb888> + Into<Rgb888>,
     {
         let (cmp, write) = self.w16_test()?;
+        depth.note_compare(cmp, write);
         let mut w = match self.prepare(v, (depth.y0(), depth.height()), false)? {
             Ok(w) => w,
             Err(stats) => return Ok(stats),
@@ -1044,7 +1044,30 @@ pub(crate) struct Runs<'a, D: DrawTarget> {
     pub(crate) fails: u32,
 }
 
-impl<D: DrawTarget> Runs<'_, D> {
+impl<'a, D: DrawTarget> Runs<'a, D> {
+    /// No run yet on row `j`, whose span starts at frame column `lo`.
+    #[inline(always)]
+    pub(crate) fn new(target: &'a mut D, lo: i32, j: i32, color: D::Color) -> Self {
+        Runs {
+            target,
+            lo,
+            j,
+            color,
+            start: 0,
+            fails: 0,
+        }
+    }
+    /// Pixels `start..end` pass: fill them.
+    #[inline(always)]
+    fn draw(&mut self, start: usize, end: usize) -> Result<(), Error> {
+        fill(
+            self.target,
+            self.lo + start as i32,
+            self.lo + end as i32,
+            self.j,
+            self.color,
+        )
+    }
     /// Pixel `k` failed: flush the run before it.
     #[inline(always)]
     pub(crate) fn fail(&mut self, k: usize) -> Result<(), Error> {
@@ -1057,13 +1080,7 @@ impl<D: DrawTarget> Runs<'_, D> {
             self.fails += (b - a) as u32;
             let start = core::mem::replace(&mut self.start, b);
             if start < a {
-                fill(
-                    self.target,
-                    self.lo + start as i32,
-                    self.lo + a as i32,
-                    self.j,
-                    self.color,
-                )?;
+                self.draw(start, a)?;
             }
         }
         Ok(())
@@ -1071,13 +1088,7 @@ impl<D: DrawTarget> Runs<'_, D> {
     #[inline(always)]
     pub(crate) fn finish(&mut self, n: usize) -> Result<(), Error> {
         if self.start < n {
-            fill(
-                self.target,
-                self.lo + self.start as i32,
-                self.lo + n as i32,
-                self.j,
-                self.color,
-            )?;
+            self.draw(self.start, n)?;
         }
         Ok(())
     }
@@ -1133,6 +1144,7 @@ fn span<R: SpanRecip, D: DrawTarget>(
     cmp: Compare,
     write: bool,
     runs: &mut Runs<'_, D>,
+    seg: &mut [u16],
 ) -> Result<(), Error> {
     let n = row.len();
     let last = t.wrapping_add((dt as u64).wrapping_mul(n as u64 - 1));
@@ -1147,10 +1159,11 @@ fn span<R: SpanRecip, D: DrawTarget>(
         && write
         && ctx.bias() == 0
     {
+        let x0 = runs.lo as usize;
         if R::DIV_SEED {
-            crate::fast::span::<Divide, D>(row, t, dt, 94 - ctx.shift_base, runs)?;
+            crate::fast::span::<Divide, D>(row, t, dt, 94 - ctx.shift_base, runs, seg, x0)?;
         } else {
-            crate::fast::span::<Chord, D>(row, t, dt, 94 - ctx.shift_base, runs)?;
+            crate::fast::span::<Chord, D>(row, t, dt, 94 - ctx.shift_base, runs, seg, x0)?;
         }
     } else if tame && in_range(t) && in_range(last) {
         recip.begin_span(smooth);

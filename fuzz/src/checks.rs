@@ -235,6 +235,32 @@ fn raster_with<R: SpanRecip>(b: &mut Bytes) {
     assert!(canvas.same_picture(&canvas2), "bands drew another picture");
     assert!(depth.data() == depth2.data(), "bands stored other codes");
 
+    // A coarse bound kept across the calls (whole frame): the same results, pictures and codes as without it, and
+    // no write outside the bound's own buffer.
+    let mut canvas4 = Canvas::new(w as u32, h as u32);
+    let mut depth4 = Guarded::new(n, 0u16, 0x5a5a);
+    let mut seg = Guarded::new(wraster::bound_len(w as usize, h as usize), 0u16, 0x3c3c);
+    {
+        let mut buf = DepthBuffer::new(depth4.inner(), w, h)
+            .unwrap()
+            .with_bound(seg.inner())
+            .unwrap();
+        buf.clear();
+        for ((g, t), want) in ops.iter().zip(&whole) {
+            same_result(want, draw(&mut r, &mut canvas4, &mut buf, *g, t));
+        }
+    }
+    depth4.check();
+    seg.check();
+    assert!(
+        canvas.same_picture(&canvas4),
+        "the coarse bound drew another picture"
+    );
+    assert!(
+        depth.data() == depth4.data(),
+        "the coarse bound stored other codes"
+    );
+
     let mut canvas3 = Canvas::new(w as u32, h as u32);
     canvas3.budget = Some(b.u16() as u32 % 512);
     let mut depth3 = Guarded::new(n, 0u16, 0x5a5a);

@@ -288,6 +288,8 @@ pub struct Run {
     pub instructions: u64,
     /// Frame hash.
     pub hash: u64,
+    /// Whether the depth buffer kept a coarse bound (feature `coarse`).
+    pub bound: bool,
 }
 
 /// Renders `scene` band by band with the given buffers (`color.len() == depth.len() == WIDTH * band rows`).
@@ -302,12 +304,13 @@ pub fn run_scene<R: SpanRecip, C: Counter>(
     run_scene_with::<R, C>(scene, color, depth, counter, |_, _| {})
 }
 
-/// [`run_scene`], handing each finished band (first row, RGB565 pixels, `WIDTH` per row) to `on_band`: a display
-/// driver pushes it out there.
-pub fn run_scene_with<R: SpanRecip, C: Counter>(
+/// [`run_scene_with`], each band's depth buffer keeping a coarse bound in `bound` (feature `coarse`; at least
+/// `wraster::bound_len(WIDTH, band rows)` long; empty: no bound).
+pub fn run_scene_bounded<R: SpanRecip, C: Counter>(
     scene: &SceneData,
     color: &mut [u16],
     depth: &mut [u16],
+    bound: &mut [u16],
     counter: &mut C,
     mut on_band: impl FnMut(u16, &[u16]),
 ) -> Result<Run, Error> {
@@ -321,7 +324,8 @@ pub fn run_scene_with<R: SpanRecip, C: Counter>(
         let n = WIDTH as usize * h as usize;
         let (color, depth) = (&mut color[..n], &mut depth[..n]);
         color.fill(0);
-        let mut buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+        let buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+        let mut buf = with_bound(buf, &mut *bound, h)?;
         buf.clear();
         let mut band = Band::new(color, y0 as i32);
         let (b0, b1) = (y0 as i32, (y0 + h) as i32 - 1);
@@ -349,7 +353,41 @@ pub fn run_scene_with<R: SpanRecip, C: Counter>(
         triangles: scene.tris.len() as u32,
         instructions,
         hash: hash.0,
+        bound: cfg!(feature = "coarse") && !bound.is_empty(),
     })
+}
+
+/// `buf` keeping a coarse bound in the front of `bound` (none when `bound` is empty).
+#[cfg_attr(not(feature = "coarse"), allow(clippy::unnecessary_wraps))]
+fn with_bound<'a>(
+    buf: DepthBuffer<'a>,
+    bound: &'a mut [u16],
+    rows: u16,
+) -> Result<DepthBuffer<'a>, Error> {
+    #[cfg(feature = "coarse")]
+    if !bound.is_empty() {
+        let n = wraster::bound_len(WIDTH as usize, rows as usize);
+        let len = bound.len();
+        let seg = bound.get_mut(..n).ok_or(Error::BufferSize {
+            expected: n,
+            actual: len,
+        })?;
+        return buf.with_bound(seg);
+    }
+    let _ = (bound, rows);
+    Ok(buf)
+}
+
+/// [`run_scene`], handing each finished band (first row, RGB565 pixels, `WIDTH` per row) to `on_band`: a display
+/// driver pushes it out there.
+pub fn run_scene_with<R: SpanRecip, C: Counter>(
+    scene: &SceneData,
+    color: &mut [u16],
+    depth: &mut [u16],
+    counter: &mut C,
+    on_band: impl FnMut(u16, &[u16]),
+) -> Result<Run, Error> {
+    run_scene_bounded::<R, C>(scene, color, depth, &mut [], counter, on_band)
 }
 
 /// Hands every triangle of a frame, with its rows, to the draw it is given.
@@ -486,6 +524,7 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE:
                     plan.band_rows,
                     color,
                     depth,
+                    &mut [],
                     counter,
                     &mut stats,
                     &mut hash,
@@ -533,6 +572,7 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE:
             triangles: (torus::TRIANGLES * torus::FRAMES) as u32,
             instructions,
             hash: hash.0,
+            bound: false,
         });
     }
     let scene = SCENES.get(SCENE).ok_or(Error::IndexOutOfRange)?;
@@ -561,6 +601,7 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE:
         triangles: scene.tris.len() as u32,
         instructions,
         hash: hash.0,
+        bound: false,
     })
 }
 
@@ -616,6 +657,19 @@ pub fn run_all<R: SpanRecip, C: Counter>(
     color: &mut [u16],
     depth: &mut [u16],
     counter: &mut C,
+    print: impl FnMut(core::fmt::Arguments<'_>),
+) -> bool {
+    run_all_bounded::<R, C>(board, core, color, depth, &mut [], counter, print)
+}
+
+/// [`run_all`] with a coarse bound in `bound` ([`run_scene_bounded`]; empty: none).
+pub fn run_all_bounded<R: SpanRecip, C: Counter>(
+    board: &str,
+    core: &str,
+    color: &mut [u16],
+    depth: &mut [u16],
+    bound: &mut [u16],
+    counter: &mut C,
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
     let mut ok = true;
@@ -623,7 +677,7 @@ pub fn run_all<R: SpanRecip, C: Counter>(
         .iter()
         .filter(|s| option_env!("ONLY").is_none_or(|o| o == s.name))
     {
-        match run_scene::<R, C>(scene, color, depth, counter) {
+        match run_scene_bounded::<R, C>(scene, color, depth, &mut *bound, counter, |_, _| {}) {
             Ok(run) => print(format_args!("{}", bench_line(board, core, &run))),
             Err(e) => {
                 print(format_args!("error board={board} scene={} {e}", scene.name));
@@ -665,6 +719,7 @@ fn mesh_frame_in_bands<R: SpanRecip, C: Counter>(
     band_h: u16,
     color: &mut [u16],
     depth: &mut [u16],
+    bound: &mut [u16],
     counter: &mut C,
     stats: &mut Stats,
     hash: &mut Fnv,
@@ -678,7 +733,8 @@ fn mesh_frame_in_bands<R: SpanRecip, C: Counter>(
         let n = w * h as usize;
         let (color, depth) = (&mut color[..n], &mut depth[..n]);
         color.fill(0);
-        let mut buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+        let buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+        let mut buf = with_bound(buf, &mut *bound, h)?;
         buf.clear();
         let mut band = Band::new(color, y0 as i32);
         counter.start();
@@ -701,6 +757,19 @@ fn mesh_frame_in_bands<R: SpanRecip, C: Counter>(
 pub fn run_torus_with<R: SpanRecip, C: Counter>(
     color: &mut [u16],
     depth: &mut [u16],
+    verts: &mut [Projected],
+    counter: &mut C,
+    frames: core::ops::Range<usize>,
+    on_band: impl FnMut(u16, &[u16]),
+) -> Result<Run, Error> {
+    run_torus_bounded::<R, C>(color, depth, &mut [], verts, counter, frames, on_band)
+}
+
+/// [`run_torus_with`], each band's depth buffer keeping a coarse bound in `bound` (feature `coarse`; empty: none).
+pub fn run_torus_bounded<R: SpanRecip, C: Counter>(
+    color: &mut [u16],
+    depth: &mut [u16],
+    bound: &mut [u16],
     verts: &mut [Projected],
     counter: &mut C,
     frames: core::ops::Range<usize>,
@@ -731,6 +800,7 @@ pub fn run_torus_with<R: SpanRecip, C: Counter>(
             band_h,
             color,
             depth,
+            &mut *bound,
             counter,
             &mut stats,
             &mut hash,
@@ -747,6 +817,7 @@ pub fn run_torus_with<R: SpanRecip, C: Counter>(
         triangles: torus::TRIANGLES as u32 * n_frames,
         instructions,
         hash: hash.0,
+        bound: cfg!(feature = "coarse") && !bound.is_empty(),
     })
 }
 
@@ -759,12 +830,35 @@ pub fn run_torus_line<R: SpanRecip, C: Counter>(
     depth: &mut [u16],
     verts: &mut [Projected],
     counter: &mut C,
+    print: impl FnMut(core::fmt::Arguments<'_>),
+) -> bool {
+    run_torus_line_bounded::<R, C>(board, core, color, depth, &mut [], verts, counter, print)
+}
+
+/// [`run_torus_line`] with a coarse bound in `bound` ([`run_torus_bounded`]; empty: none).
+#[allow(clippy::too_many_arguments)]
+pub fn run_torus_line_bounded<R: SpanRecip, C: Counter>(
+    board: &str,
+    core: &str,
+    color: &mut [u16],
+    depth: &mut [u16],
+    bound: &mut [u16],
+    verts: &mut [Projected],
+    counter: &mut C,
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
     if option_env!("ONLY").is_some_and(|o| o != "torus") {
         return true;
     }
-    match run_torus::<R, C>(color, depth, verts, counter) {
+    match run_torus_bounded::<R, C>(
+        color,
+        depth,
+        bound,
+        verts,
+        counter,
+        0..wraster::scenes::torus::FRAMES,
+        |_, _| {},
+    ) {
         Ok(run) => {
             let mut line = bench_line(board, core, &run);
             let frames = wraster::scenes::torus::FRAMES as u64;
@@ -872,7 +966,7 @@ pub fn bench_line_of(board: &str, core: &str, format: &str, run: &Run) -> heaple
     let (px, fr) = (run.stats.written as u64, run.stats.fragments as u64);
     let _ = write!(
         s,
-        "bench board={board} core={core} scene={} format={format} bands={} pixels={px} fragments={fr} triangles={} instructions={} instr_per_px={} instr_per_fragment={} instr_per_tri={} hash={:016x} recip={}",
+        "bench board={board} core={core} scene={} format={format} bands={} pixels={px} fragments={fr} triangles={} instructions={} instr_per_px={} instr_per_fragment={} instr_per_tri={} hash={:016x} recip={} bound={}",
         run.scene,
         run.bands,
         run.triangles,
@@ -881,7 +975,8 @@ pub fn bench_line_of(board: &str, core: &str, format: &str, run: &Run) -> heaple
         Ratio(run.instructions, fr),
         Ratio(run.instructions, run.triangles as u64),
         run.hash,
-        run.recip
+        run.recip,
+        if run.bound { "coarse" } else { "none" }
     );
     s
 }

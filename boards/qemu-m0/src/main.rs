@@ -131,9 +131,25 @@ fn main() -> ! {
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
+    // The coarse bound of `--features coarse`: one code per 8 pixels of each band row (640 bytes).
+    #[cfg(feature = "coarse")]
+    static mut BOUND: [u16; wraster::bound_len(WIDTH as usize, BAND_ROWS)] =
+        [0; wraster::bound_len(WIDTH as usize, BAND_ROWS)];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
     let ok = all::<Fast>(COLOR, DEPTH, &mut counter);
+    // `--features coarse`: the default again with a coarse depth bound (`bound=coarse` lines), same hashes.
+    #[cfg(feature = "coarse")]
+    let ok = ok
+        & wraster_board::run_all_bounded::<Fast, _>(
+            "qemu-m0",
+            "m0",
+            COLOR,
+            DEPTH,
+            BOUND,
+            &mut counter,
+            |line| hprintln!("{}", line),
+        );
     // `--features size-probe` runs the default strategy only (profiles, cycle estimates: boards/tools/cycles.py).
     #[cfg(not(feature = "size-probe"))]
     // The other strategies for the hash test (`FastDiv`, the M4's and RV32's default: its division is a library

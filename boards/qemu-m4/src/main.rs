@@ -57,6 +57,10 @@ fn all<R: SpanRecip>(
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
+    // The coarse bound of `--features coarse`: one code per 8 pixels of each row.
+    #[cfg(feature = "coarse")]
+    static mut BOUND: [u16; wraster::bound_len(WIDTH as usize, HEIGHT as usize)] =
+        [0; wraster::bound_len(WIDTH as usize, HEIGHT as usize)];
     static mut VERTS: [Projected; VERTICES] = [Projected {
         x: 0.0,
         y: 0.0,
@@ -79,6 +83,30 @@ fn main() -> ! {
         & wraster_board::cull_line("qemu-m4", "m4", VERTS, &mut counter, |line| {
             hprintln!("{}", line)
         });
+    // `--features coarse`: the default again with a coarse depth bound (`bound=coarse` lines), same hashes.
+    #[cfg(all(feature = "coarse", feature = "torus"))]
+    let ok = ok
+        & wraster_board::run_torus_line_bounded::<FastDiv, _>(
+            "qemu-m4",
+            "m4",
+            COLOR,
+            DEPTH,
+            BOUND,
+            VERTS,
+            &mut counter,
+            |line| hprintln!("{}", line),
+        );
+    #[cfg(all(feature = "coarse", not(feature = "torus")))]
+    let ok = ok
+        & wraster_board::run_all_bounded::<FastDiv, _>(
+            "qemu-m4",
+            "m4",
+            COLOR,
+            DEPTH,
+            BOUND,
+            &mut counter,
+            |line| hprintln!("{}", line),
+        );
     // `--features f32-div` adds the f32-division reciprocal (one VDIV on this core), for comparison (README).
     #[cfg(feature = "f32-div")]
     let ok = ok
