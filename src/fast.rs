@@ -1020,7 +1020,7 @@ mod tests {
                 .map(|k| {
                     let vk = v.wrapping_add(dv.wrapping_mul(k as u64));
                     let edge = (b.lim / ((vk >> 49) as u32).max(1)).min(65535) as i64;
-                    let d = if rnd(state) % 40 == 0 {
+                    let d = if rnd(state).is_multiple_of(40) {
                         1 + (rnd(state) % 8) as i64
                     } else {
                         -((rnd(state) % 4) as i64)
@@ -1046,7 +1046,8 @@ mod tests {
                 "up {UP} {plain:?} {coarse:?}"
             );
             // Whether a whole aligned segment in the span was skipped (every pixel ruled out).
-            let skipped_whole = (0..plain.0).any(|k| (x0 + k0 + k) % 8 == 0 && k + 8 <= plain.0);
+            let skipped_whole =
+                (0..plain.0).any(|k| (x0 + k0 + k).is_multiple_of(8) && k + 8 <= plain.0);
             (1, u32::from(skipped_whole))
         }
         let mut state = 0xC0A5_E000_0000_0001_u64;
