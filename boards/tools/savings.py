@@ -4,7 +4,7 @@
 For each standard scene and W4 (the torus) and each core (the M4 and M0 QEMU boards), it runs the planner
 (`cargo run --release -p host-tests --bin plan -- <scene> --core <core> --measure`: ranked by the
 instructions each candidate costs on the board), then builds two firmwares and measures each:
-- the plan's: `PLAN=<plan file> cargo run --release --features plan` in the board (only the plan's format, strategy
+- the plan's: `PLAN=<plan file> cargo run --release --features plan` (`plan,coarse` for a plan that keeps the coarse depth bound) in the board (only the plan's format, strategy
   and depth path; the depth buffer sized from the plan);
 - the general default: the same board's default build of that scene alone (`ONLY=<scene> --features size-probe`, or
   `--features torus,size-probe`): W16, the core's default strategy, the scene's own depth range, the board's own
@@ -94,17 +94,20 @@ def main():
                        '--core', core, '--out', plan_file, '--measure'], ROOT)
             pline = [l for l in pout.splitlines() if l.startswith('plan ')][-1]
             torus = scene == 'torus'
-            p = measure(core, scene, {'PLAN': plan_file}, 'plan')
+            feats = field(pline, 'features')
+            # A plan that keeps the coarse depth bound is built with it (its firmware names the feature).
+            p = measure(core, scene, {'PLAN': plan_file}, 'plan,coarse' if 'coarse' in feats.split(',') else 'plan')
             d = measure(core, scene, {} if torus else {'ONLY': scene}, 'torus,size-probe' if torus else 'size-probe')
             fmt = field(pline, 'format')
-            r = dict(scene=scene, core=core, format=fmt, strategy=field(pline, 'strategy'), plan=p, default=d,
+            r = dict(scene=scene, core=core, format=fmt, strategy=field(pline, 'strategy'), features=feats, plan=p,
+                     default=d,
                      plan_depth=int(field(pline, 'depth_ram')), default_depth=DEFAULT_DEPTH[(core, torus)],
                      plan_err=int(field(pline, 'visibility_errors')),
                      default_err=int(field(pline, 'default_visibility_errors')),
                      budget_met=field(pline, 'budget_met'))
             rows.append(r)
             lines.append(
-                f"savings scene={scene} core={core} plan_format={fmt} plan_strategy={r['strategy']} "
+                f"savings scene={scene} core={core} plan_format={fmt} plan_strategy={r['strategy']} plan_features={feats} "
                 f"plan_lib_text={p['lib']} default_lib_text={d['lib']} plan_text={p['text']} default_text={d['text']} "
                 f"plan_bss={p['bss']} default_bss={d['bss']} plan_depth_ram={r['plan_depth']} "
                 f"default_depth_ram={r['default_depth']} plan_instr_per_frame={p['instr']:.0f} "
@@ -124,6 +127,8 @@ def main():
     for r in rows:
         p, d = r['plan'], r['default']
         name = 'none' if r['format'] == 'none' else f"{r['format']} {r['strategy']}"
+        if r['features'] != 'none':
+            name += f" + {r['features']}"
         if r['budget_met'] != 'true':
             name += ' (budget not met)'
         md.append(f"| {r['scene']} | {r['core'].upper()} | {name} | {p['lib']:,} / {d['lib']:,} | "

@@ -368,6 +368,19 @@ pub fn in_bands(
     w: u16,
     h: u16,
     band_h: u16,
+    draw: impl FnMut(&mut DepthBuffer<'_>) -> Result<Stats, Error>,
+) -> Result<Stats, Error> {
+    in_bands_bounded(depth, w, h, band_h, &mut [], draw)
+}
+
+/// [`in_bands`], each band's buffer keeping a coarse bound in the front of `bound` (`wraster::bound_len(w, band_h)`
+/// long; empty: none).
+pub fn in_bands_bounded(
+    depth: &mut [u16],
+    w: u16,
+    h: u16,
+    band_h: u16,
+    bound: &mut [u16],
     mut draw: impl FnMut(&mut DepthBuffer<'_>) -> Result<Stats, Error>,
 ) -> Result<Stats, Error> {
     let mut stats = Stats::default();
@@ -376,6 +389,15 @@ pub fn in_bands(
         let bh = band_h.min(h - y0);
         let slice = &mut depth[y0 as usize * w as usize..(y0 + bh) as usize * w as usize];
         let mut buf = DepthBuffer::band(slice, w, y0 as i32, bh)?;
+        if !bound.is_empty() {
+            let n = wraster::bound_len(w as usize, bh as usize);
+            let len = bound.len();
+            let seg = bound.get_mut(..n).ok_or(Error::BufferSize {
+                expected: n,
+                actual: len,
+            })?;
+            buf = buf.with_bound(seg)?;
+        }
         buf.clear();
         stats += draw(&mut buf)?;
         y0 += bh;

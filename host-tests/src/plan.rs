@@ -577,11 +577,58 @@ impl Plan {
         .unwrap();
         writeln!(
             s,
-            "/// The plan.\npub const PLAN: crate::PlanData = crate::PlanData {{ scene: {:?}, format: {:?}, near: f32::from_bits({:#010x}), far: f32::from_bits({:#010x}), band_rows: {}, depth_ram: {}, visibility_errors: {} }};",
-            self.scene, self.format, self.near.to_bits(), self.far.to_bits(), self.band_rows, self.depth_ram, self.visibility_errors
+            "/// The plan.\npub const PLAN: crate::PlanData = crate::PlanData {{ scene: {:?}, format: {:?}, near: f32::from_bits({:#010x}), far: f32::from_bits({:#010x}), band_rows: {}, depth_ram: {}, visibility_errors: {}, coarse: {} }};",
+            self.scene, self.format, self.near.to_bits(), self.far.to_bits(), self.band_rows, self.depth_ram, self.visibility_errors, self.coarse()
         )
         .unwrap();
+        if self.coarse() {
+            writeln!(
+                s,
+                "const _: () = assert!(cfg!(feature = \"coarse\"), \"this plan keeps a coarse depth bound: build with --features plan,coarse\");"
+            )
+            .unwrap();
+        }
         s
+    }
+
+    /// Whether the plan keeps a coarse depth bound (feature `coarse`).
+    pub fn coarse(&self) -> bool {
+        self.features.contains(&"coarse")
+    }
+
+    /// The board features its firmware is built with (`plan`, and `coarse` when it keeps the bound).
+    pub fn board_features(&self) -> Vec<&'static str> {
+        if self.coarse() {
+            vec!["plan", "coarse"]
+        } else {
+            vec!["plan"]
+        }
+    }
+
+    /// This W16 fast-tier plan with a coarse depth bound beside its buffer (feature `coarse`): one `u16` per 8 pixels
+    /// of each band row, so the bands shrink to keep depth and bound within `depth_ram` bytes. `None` for another
+    /// format or strategy (only the fast tier's span loop uses the bound). The pictures are the same as without it.
+    pub fn with_coarse(&self, w: u16, h: u16, depth_ram: usize) -> Option<Plan> {
+        if self.format != "W16"
+            || !matches!(self.strategy.as_str(), "fast" | "fast-div")
+            || self.coarse()
+        {
+            return None;
+        }
+        let row = w as usize * 2 + wraster::bound_len(w as usize, 1) * 2;
+        let rows = (depth_ram / row).min(h as usize) as u16;
+        if rows == 0 {
+            return None;
+        }
+        let mut features = self.features.clone();
+        features.push("coarse");
+        Some(Plan {
+            band_rows: rows,
+            bands: h.div_ceil(rows),
+            depth_ram: row * rows as usize,
+            features,
+            ..self.clone()
+        })
     }
 }
 
@@ -765,8 +812,11 @@ pub fn measure_on_board(cands: &[Plan], dir: &std::path::Path) -> Result<Vec<f64
             std::fs::write(&f, p.rust("plan --measure (a candidate)"))
                 .map_err(|e| e.to_string())?;
             let file = f.canonicalize().map_err(|e| e.to_string())?;
-            let out =
-                crate::run_board_env(board, &["plan"], &[("PLAN", &file.display().to_string())])?;
+            let out = crate::run_board_env(
+                board,
+                &p.board_features(),
+                &[("PLAN", &file.display().to_string())],
+            )?;
             let line = out
                 .lines()
                 .find(|l| {
@@ -866,7 +916,13 @@ fn plan_hash_as<R: SpanRecip>(plan: &Plan) -> Result<(u64, u32, u32), Error> {
                     depth = d;
                     stats += s;
                 } else {
-                    stats += in_bands(&mut depth, wl.w, wl.h, plan.band_rows, |buf| {
+                    // With the plan's coarse bound, as its firmware keeps it (the same frames either way).
+                    let mut seg = match plan.coarse() {
+                        true => vec![0u16; wraster::bound_len(w, plan.band_rows as usize)],
+                        false => vec![],
+                    };
+                    let (ww, hh, rows) = (wl.w, wl.h, plan.band_rows);
+                    stats += crate::in_bands_bounded(&mut depth, ww, hh, rows, &mut seg, |buf| {
                         let mut s = wraster::Stats::default();
                         for t in tris {
                             s += r.draw(&mut frame, buf, t)?;

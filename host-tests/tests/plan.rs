@@ -347,3 +347,70 @@ fn an_obj_scene_plans_along_its_camera_path() {
         .contains("not obj-links"));
     assert!(workload("obj:/no/such/file.obj").is_err());
 }
+
+/// A W16 fast-tier plan with the coarse depth bound (`Plan::with_coarse`, what `--measure` also tries): its depth
+/// and bound stay within the budget's RAM (shorter bands), other formats and strategies get none, and the boards
+/// built from it (`--features plan,coarse`) print the host's hash, pixels and fragments, which are those of the same
+/// plan without the bound. Needs QEMU, as `firmware.rs` (`WRASTER_SKIP_FIRMWARE=1` skips knowingly).
+#[test]
+fn coarse_plans_draw_the_same_frames() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/plans-test/coarse");
+    std::fs::create_dir_all(&dir).unwrap();
+    for (board, core, scenes) in [
+        ("qemu-m4", Core::M4, vec!["overdraw", "torus"]),
+        ("qemu-m0", Core::M0, vec!["overdraw"]),
+    ] {
+        let mut files = vec![];
+        let mut want = std::collections::HashMap::new();
+        for scene in scenes {
+            let wl = workload(scene).unwrap();
+            let b = budget(core, scene);
+            let p = plan(&wl, b).unwrap();
+            assert_eq!(p.format, "W16", "{scene}");
+            let c = p.with_coarse(wl.w, wl.h, b.depth_ram).unwrap();
+            assert!(
+                c.coarse() && c.depth_ram <= b.depth_ram && c.band_rows < p.band_rows,
+                "{c:?}"
+            );
+            assert_eq!(c.board_features(), ["plan", "coarse"]);
+            let mut exact = p.clone();
+            exact.strategy = "exact".into();
+            assert!(exact.with_coarse(wl.w, wl.h, b.depth_ram).is_none());
+            let host = plan_hash(&c).unwrap();
+            assert_eq!(
+                host,
+                plan_hash(&p).unwrap(),
+                "{scene}: the bound changed the frames"
+            );
+            let f = dir.join(format!("{scene}-{}.rs", core.name()));
+            std::fs::write(&f, c.rust("the coarse plan test")).unwrap();
+            files.push(f.display().to_string());
+            want.insert(scene.to_string(), host);
+        }
+        if !qemu() {
+            continue;
+        }
+        let out = run_board_env(board, &["plan", "coarse"], &[("PLAN", &files.join(","))])
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut seen = 0;
+        for line in out.lines().filter(|l| l.starts_with("bench ")) {
+            let f = |k: &str| {
+                host_tests::field(line, k)
+                    .unwrap_or_else(|| panic!("no {k} in {line}"))
+                    .to_string()
+            };
+            let (hash, written, fragments) = want[&f("scene")];
+            assert_eq!(
+                (f("hash"), f("pixels"), f("fragments")),
+                (
+                    format!("{hash:016x}"),
+                    written.to_string(),
+                    fragments.to_string()
+                ),
+                "{line}"
+            );
+            seen += 1;
+        }
+        assert_eq!(seen, want.len(), "{board}: {out}");
+    }
+}

@@ -64,6 +64,8 @@ pub struct PlanData {
     pub depth_ram: usize,
     /// Visibility errors the host measured for the plan.
     pub visibility_errors: u32,
+    /// Whether the W16 buffer keeps a coarse bound (feature `coarse`), stored after the band in the depth RAM.
+    pub coarse: bool,
 }
 
 /// A plan's depth path (its `PLAN_KIND`, a const generic of [`run_plan`], so a firmware links only its own): no
@@ -357,6 +359,15 @@ pub fn run_scene_bounded<R: SpanRecip, C: Counter>(
     })
 }
 
+/// The first `n` words of a plan's depth storage (the W16 band) and the rest (a coarse bound's room).
+fn split_depth(depth: &mut [u16], n: usize) -> Result<(&mut [u16], &mut [u16]), Error> {
+    let actual = depth.len();
+    depth.split_at_mut_checked(n).ok_or(Error::BufferSize {
+        expected: n,
+        actual,
+    })
+}
+
 /// `buf` keeping a coarse bound in the front of `bound` (none when `bound` is empty).
 #[cfg_attr(not(feature = "coarse"), allow(clippy::unnecessary_wraps))]
 fn with_bound<'a>(
@@ -441,8 +452,9 @@ fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
                 hash.words(&band.px[row * w..(row + 1) * w]);
             }
         } else if KIND == LEAN_W16 {
-            let depth = &mut depth[..n];
-            let mut buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+            let (depth, rest) = split_depth(depth, n)?;
+            let buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
+            let mut buf = with_bound(buf, if plan.coarse { rest } else { &mut [] }, h)?;
             buf.clear();
             counter.start();
             let res = tris(&mut |v, rr| {
@@ -517,14 +529,17 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE:
             instructions += counter.stop();
             let frame = frame?;
             let (i, b) = if KIND == LEAN_W16 {
-                // W16: the mesh path itself (binning by rows, its own cull), as `run_torus` draws.
+                // W16: the mesh path itself (binning by rows, its own cull), as `run_torus` draws; the coarse bound,
+                // if the plan keeps one, after the band.
+                let n = WIDTH as usize * plan.band_rows as usize;
+                let (depth, rest) = split_depth(depth, n)?;
                 mesh_frame_in_bands(
                     &mut r,
                     &frame,
                     plan.band_rows,
                     color,
                     depth,
-                    &mut [],
+                    if plan.coarse { rest } else { &mut [] },
                     counter,
                     &mut stats,
                     &mut hash,
@@ -572,7 +587,7 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE:
             triangles: (torus::TRIANGLES * torus::FRAMES) as u32,
             instructions,
             hash: hash.0,
-            bound: false,
+            bound: cfg!(feature = "coarse") && plan.coarse && KIND == LEAN_W16,
         });
     }
     let scene = SCENES.get(SCENE).ok_or(Error::IndexOutOfRange)?;
@@ -601,7 +616,7 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE:
         triangles: scene.tris.len() as u32,
         instructions,
         hash: hash.0,
-        bound: false,
+        bound: cfg!(feature = "coarse") && plan.coarse && KIND == LEAN_W16,
     })
 }
 
