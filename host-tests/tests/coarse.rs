@@ -118,7 +118,7 @@ fn random_overdraw_is_the_same_with_the_bound() {
 
 /// After one big triangle (W1) the bound of the aligned segments that the fast tier's span loop drew whole is within
 /// one code above each segment's largest code, not the far code it started from: the bound is lowered as the
-/// buffer is written, to one above the larger end code of the segment (the fast tier's codes are within `2^-11.4`
+/// buffer is written, to one above the larger end code of the segment (the fast tier's codes are within `2^-11.1`
 /// of the exact ones, which are monotone along a span, so no middle code exceeds the larger end's by more than one).
 /// Spans drawn by the per-pixel loop (short or steep ones) leave their segments' bounds as they were, still above.
 #[test]
