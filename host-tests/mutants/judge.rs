@@ -12,6 +12,8 @@ mod bias;
 mod boundaries;
 #[path = "../tests/clip.rs"]
 mod clip;
+#[path = "../tests/coarse.rs"]
+mod coarse;
 #[path = "../tests/compare.rs"]
 mod compare;
 #[path = "../tests/fixed_input.rs"]
