@@ -1000,6 +1000,35 @@ mod tests {
         }
     }
 
+    /// `Coarse::lower` lowers exactly the aligned 8-pixel segments (in frame columns) that the run `a..b` covers
+    /// whole, each to one above the larger of its two end codes (never raising one), and leaves every other alone:
+    /// for every span offset within a segment, every run start and end.
+    #[test]
+    fn lower_takes_every_whole_segment_of_a_run_and_no_other() {
+        let mut state = 0xC0A5_E000_0000_0002_u64;
+        let n = 40usize;
+        for x0 in 0..16usize {
+            for a in 0..n {
+                for b in a..=n {
+                    let row: std::vec::Vec<u16> =
+                        (0..n).map(|_| (rnd(&mut state) % 60_000) as u16).collect();
+                    let old = (rnd(&mut state) % 65_536) as u16;
+                    let mut seg = std::vec![old; (x0 + n).div_ceil(8)];
+                    Coarse { seg: &mut seg, x0 }.lower(&row, a, b);
+                    for (i, &g) in seg.iter().enumerate() {
+                        let (lo, hi) = (i * 8, i * 8 + 8);
+                        let want = if lo >= x0 + a && hi <= x0 + b {
+                            old.min(row[lo - x0].max(row[hi - 1 - x0]) + 1)
+                        } else {
+                            old
+                        };
+                        assert_eq!(g, want, "x0 {x0} run {a}..{b} segment {i}");
+                    }
+                }
+            }
+        }
+    }
+
     /// With a valid coarse bound (each segment's at least its largest stored code), the prefilter with the bound ends
     /// where the per-pixel one does, with the same `v`: on random rows, both directions, spans starting anywhere in
     /// a segment, bounds exact or above the largest code; and it does skip whole segments (the test is not vacuous).
