@@ -1000,6 +1000,47 @@ mod tests {
         }
     }
 
+    /// Which pixels the coarse test skips without reading them: with a limit of 0 the per-pixel test rules out no
+    /// stored code above 0, so a bound of 0 (below the stored codes, which a real buffer never has) marks exactly the
+    /// segments skipped whole. From an aligned first pixel, the leading segments whose bound is 0 are skipped (`v`
+    /// moved by 8 steps each) and the walk stops at the first pixel of the next; from an unaligned one, it stops at
+    /// once; without `COARSE`, at once. Both directions, spans starting at several segments.
+    #[test]
+    fn the_coarse_test_skips_whole_segments_by_their_bound() {
+        fn check<const UP: bool>() {
+            let v = if UP {
+                (1u64 << 62) + (1 << 40)
+            } else {
+                u64::MAX - (1 << 40)
+            };
+            let dv = if UP {
+                1u64 << 32
+            } else {
+                (1u64 << 32).wrapping_neg()
+            };
+            let row = [7u16; 48];
+            for x0 in [0usize, 8, 16, 24, 3, 13] {
+                for zeros in 0..4 {
+                    let mut seg = std::vec![1u16; 16];
+                    for g in seg.iter_mut().skip(x0 / 8).take(zeros) {
+                        *g = 0;
+                    }
+                    let c = Coarse { seg: &mut seg, x0 };
+                    let got = skip_run::<UP, true>(&row, v, dv, 0, &c, 0);
+                    let k = if x0 % 8 == 0 { 8 * zeros } else { 0 };
+                    let want = (k, v.wrapping_add(dv.wrapping_mul(k as u64)), End::Fail);
+                    assert_eq!(got, want, "up {UP} x0 {x0} zeros {zeros}");
+                    assert_eq!(
+                        skip_run::<UP, false>(&row, v, dv, 0, &c, 0),
+                        (0, v, End::Fail)
+                    );
+                }
+            }
+        }
+        check::<true>();
+        check::<false>();
+    }
+
     /// `Coarse::lower` lowers exactly the aligned 8-pixel segments (in frame columns) that the run `a..b` covers
     /// whole, each to one above the larger of its two end codes (never raising one), and leaves every other alone:
     /// for every span offset within a segment, every run start and end.
