@@ -1039,6 +1039,24 @@ mod tests {
         }
         check::<true>();
         check::<false>();
+        // At the binade's edge: upward, a segment whose last pixel would reach 2^63 (outside the binade) is not
+        // tested whole; downward, one whose last pixel is exactly 2^63 (inside) is, and the step after it leaves.
+        let (row, d) = ([7u16; 16], 1u64 << 32);
+        let mut seg = std::vec![0u16; 2];
+        let c = Coarse {
+            seg: &mut seg,
+            x0: 0,
+        };
+        let up = (1u64 << 63) - 7 * d;
+        assert_eq!(
+            skip_run::<true, true>(&row, up, d, 0, &c, 0),
+            (0, up, End::Fail)
+        );
+        let down = (1u64 << 63) + 7 * d;
+        assert_eq!(
+            skip_run::<false, true>(&row, down, d.wrapping_neg(), 0, &c, 0),
+            (8, (1u64 << 63) - d, End::Binade)
+        );
     }
 
     /// `Coarse::lower` lowers exactly the aligned 8-pixel segments (in frame columns) that the run `a..b` covers
