@@ -11,6 +11,13 @@ use wraster::{RenderState, Vertex};
 
 /// Whether QEMU is here to run the boards; without it a test fails unless told to skip (`WRASTER_SKIP_FIRMWARE=1`,
 /// as `firmware.rs`).
+/// Key `k` of a board's output line (it must be there).
+fn key(line: &str, k: &str) -> String {
+    host_tests::field(line, k)
+        .unwrap_or_else(|| panic!("no {k} in {line}"))
+        .to_string()
+}
+
 fn qemu() -> bool {
     if have("qemu-system-arm") {
         return true;
@@ -226,11 +233,7 @@ fn boards_built_from_plans_draw_the_hosts_frames() {
                 .unwrap_or_else(|e| panic!("{e}"));
             let mut seen = 0;
             for line in out.lines().filter(|l| l.starts_with("bench ")) {
-                let f = |k: &str| {
-                    host_tests::field(line, k)
-                        .unwrap_or_else(|| panic!("no {k} in {line}"))
-                        .to_string()
-                };
+                let f = |k: &str| key(line, k);
                 let (p, (hash, written, fragments)) = &want[&f("scene")];
                 assert_eq!(f("hash"), format!("{hash:016x}"), "{line}");
                 assert_eq!(f("pixels"), written.to_string(), "{line}");
@@ -394,11 +397,7 @@ fn coarse_plans_draw_the_same_frames() {
             .unwrap_or_else(|e| panic!("{e}"));
         let mut seen = 0;
         for line in out.lines().filter(|l| l.starts_with("bench ")) {
-            let f = |k: &str| {
-                host_tests::field(line, k)
-                    .unwrap_or_else(|| panic!("no {k} in {line}"))
-                    .to_string()
-            };
+            let f = |k: &str| key(line, k);
             let (hash, written, fragments) = want[&f("scene")];
             assert_eq!(
                 (f("hash"), f("pixels"), f("fragments")),
