@@ -119,7 +119,7 @@ fn plans() {
         .unwrap();
         writeln!(
             calls,
-            "    ok &= crate::run_plan_line::<p{k}::PlanFormat, p{k}::PlanStrategy, C, {{ p{k}::PLAN_KIND }}, {{ p{k}::PLAN_SCENE }}>(board, core, &p{k}::PLAN, color, depth, verts, counter, &mut *print);"
+            "    ok &= crate::run_plan_line::<p{k}::PlanFormat, p{k}::PlanStrategy, C, {{ p{k}::PLAN_KIND }}, {{ p{k}::PLAN_SCENE }}>(board, core, &p{k}::PLAN, color, depth, verts, bins, counter, &mut *print);"
         )
         .unwrap();
         ram.push(format!("p{k}::PLAN.depth_ram"));
@@ -151,12 +151,12 @@ fn plans() {
     writeln!(s, "/// Whether a plan draws W4's torus (its vertices need RAM).\npub const HAS_TORUS: bool = false{};", torus.iter().map(|t| format!(" || {t}")).collect::<String>()).unwrap();
     writeln!(
         s,
-        "/// The `u16` words of depth storage a board gives the plans.\npub const DEPTH_LEN: usize = MAX_DEPTH_RAM.div_ceil(2);\n/// The transformed vertices a board stores for the plans (the torus's, or none).\npub const VERTS_LEN: usize = if HAS_TORUS {{ wraster::scenes::torus::VERTICES }} else {{ 0 }};"
+        "/// The `u16` words of depth storage a board gives the plans.\npub const DEPTH_LEN: usize = MAX_DEPTH_RAM.div_ceil(2);\n/// The transformed vertices a board stores for the plans (the torus's, or none).\npub const VERTS_LEN: usize = if HAS_TORUS {{ wraster::scenes::torus::VERTICES }} else {{ 0 }};\n/// The row bins a board stores for the plans (a byte per torus triangle, or none).\npub const BINS_LEN: usize = if HAS_TORUS {{ wraster::scenes::torus::TRIANGLES }} else {{ 0 }};"
     )
     .unwrap();
     writeln!(
         s,
-        "/// Runs every plan, printing its `bench` line; `false` when one failed.\n#[allow(unused_variables, unused_mut, clippy::let_and_return)]\npub fn run_all_plans<C: crate::Counter>(board: &str, core: &str, color: &mut [u16], depth: &mut [u16], verts: &mut [wraster::mesh::Projected], counter: &mut C, print: &mut dyn FnMut(core::fmt::Arguments<'_>)) -> bool {{\n    let mut ok = true;\n{calls}    ok\n}}"
+        "/// Runs every plan, printing its `bench` line; `false` when one failed.\n#[allow(unused_variables, unused_mut, clippy::let_and_return, clippy::too_many_arguments)]\npub fn run_all_plans<C: crate::Counter>(board: &str, core: &str, color: &mut [u16], depth: &mut [u16], verts: &mut [wraster::mesh::Projected], bins: &mut [u8], counter: &mut C, print: &mut dyn FnMut(core::fmt::Arguments<'_>)) -> bool {{\n    let mut ok = true;\n{calls}    ok\n}}"
     )
     .unwrap();
     let out = std::path::PathBuf::from(std::env::var("OUT_DIR").unwrap()).join("plans.rs");

@@ -648,7 +648,6 @@ pub fn world(data: &[u8]) {
         mcanvas.same_picture(&mcanvas2) && mdepth.data() == mdepth2.data(),
         "mesh: bands differ"
     );
-
     // The same triangle in a packed Z format (draw_world_format), and a failing target.
     let mut zst = st;
     zst.mode = DepthMode::Z;
@@ -692,6 +691,51 @@ pub fn world(data: &[u8]) {
     fd.check();
     let mut once = Some(fres);
     failing_matches(&[mwhole], |_| once.take().expect("one call"));
+    // The frame binned by rows (bin_mesh), in the same bands: the same picture, codes, fragments and writes; bins
+    // shorter than the triangles are an error.
+    if let Ok(f) = &frame {
+        let nb = if b.u8() % 8 == 0 {
+            b.u8() as usize % 12
+        } else {
+            indices.len()
+        };
+        let mut bins = vec![0u8; nb];
+        match r.bin_mesh(*f, &mut bins) {
+            Err(e) => {
+                assert!(nb < indices.len(), "{e:?}");
+                assert_eq!(
+                    e,
+                    Error::BufferSize {
+                        expected: indices.len(),
+                        actual: nb
+                    }
+                );
+            }
+            Ok(binned) => {
+                assert!(binned.binned_culled().is_some());
+                let mut bcanvas = Canvas::new(w as u32, h as u32);
+                let mut bdepth = Guarded::new(n, 0u16, 0x5a5a);
+                bdepth.inner().copy_from_slice(&cleared);
+                let mut bsum = Ok(Stats::default());
+                for y0 in (0..h).step_by(band as usize) {
+                    let hh = band.min(h - y0);
+                    let rows = y0 as usize * w as usize..(y0 + hh) as usize * w as usize;
+                    let mut buf =
+                        DepthBuffer::band(&mut bdepth.inner()[rows], w, y0 as i32, hh).unwrap();
+                    add(
+                        &mut bsum,
+                        draw_frame(&mut r, &mut bcanvas, &mut buf, &Ok(binned)),
+                    );
+                }
+                bdepth.check();
+                same_result(&mwhole, bsum);
+                assert!(
+                    mcanvas.same_picture(&bcanvas) && mdepth.data() == bdepth.data(),
+                    "mesh: the binned frame differs"
+                );
+            }
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------------------

@@ -505,6 +505,7 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE:
     color: &mut [u16],
     depth: &mut [u16],
     verts: &mut [Projected],
+    bins: &mut [u8],
     counter: &mut C,
 ) -> Result<Run, Error> {
     let mut stats = Stats::default();
@@ -525,7 +526,15 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE:
         for k in 0..torus::FRAMES {
             let m = cam.model_matrix(&torus::model(k));
             counter.start();
-            let frame = r.transform_mesh(&mesh, &m, &vp, verts);
+            // W16 in more than one band: binned by rows as `run_torus` does, when the board gives the bins.
+            let binned = KIND == LEAN_W16 && plan.band_rows < HEIGHT && !bins.is_empty();
+            let frame = r.transform_mesh(&mesh, &m, &vp, verts).and_then(|f| {
+                if binned {
+                    r.bin_mesh(f, &mut *bins)
+                } else {
+                    Ok(f)
+                }
+            });
             instructions += counter.stop();
             let frame = frame?;
             let (i, b) = if KIND == LEAN_W16 {
@@ -630,10 +639,11 @@ pub fn run_plan_line<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const S
     color: &mut [u16],
     depth: &mut [u16],
     verts: &mut [Projected],
+    bins: &mut [u8],
     counter: &mut C,
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
-    match run_plan::<F, R, C, KIND, SCENE>(plan, color, depth, verts, counter) {
+    match run_plan::<F, R, C, KIND, SCENE>(plan, color, depth, verts, bins, counter) {
         Ok(run) => {
             // The bench line with the plan's format.
             let mut line = bench_line_of(board, core, plan.format, &run);
@@ -705,18 +715,22 @@ pub fn run_all_bounded<R: SpanRecip, C: Counter>(
 
 /// W4 "torus" (`wraster::scenes::torus`): 8 frames of the rotating mesh, each transformed once
 /// ([`Rasterizer::transform_mesh`] into `verts`, at least 512) and drawn band by band
-/// ([`Rasterizer::draw_mesh_frame`]) with the given buffers, depth cleared per band. Counts the transform and the
+/// ([`Rasterizer::draw_mesh_frame`]) with the given buffers, depth cleared per band; binned by rows
+/// ([`Rasterizer::bin_mesh`]) into `bins` (a byte per triangle) when `bins` is not empty, which pays when the frame
+/// is drawn in more than one band (the pixels are the same either way). Counts the transform, the binning and the
 /// draws (not the clears or the hash); the hash runs over the 8 frames in order.
 pub fn run_torus<R: SpanRecip, C: Counter>(
     color: &mut [u16],
     depth: &mut [u16],
     verts: &mut [Projected],
+    bins: &mut [u8],
     counter: &mut C,
 ) -> Result<Run, Error> {
     run_torus_with::<R, C>(
         color,
         depth,
         verts,
+        bins,
         counter,
         0..wraster::scenes::torus::FRAMES,
         |_, _| {},
@@ -773,19 +787,22 @@ pub fn run_torus_with<R: SpanRecip, C: Counter>(
     color: &mut [u16],
     depth: &mut [u16],
     verts: &mut [Projected],
+    bins: &mut [u8],
     counter: &mut C,
     frames: core::ops::Range<usize>,
     on_band: impl FnMut(u16, &[u16]),
 ) -> Result<Run, Error> {
-    run_torus_bounded::<R, C>(color, depth, &mut [], verts, counter, frames, on_band)
+    run_torus_bounded::<R, C>(color, depth, &mut [], verts, bins, counter, frames, on_band)
 }
 
 /// [`run_torus_with`], each band's depth buffer keeping a coarse bound in `bound` (feature `coarse`; empty: none).
+#[allow(clippy::too_many_arguments)]
 pub fn run_torus_bounded<R: SpanRecip, C: Counter>(
     color: &mut [u16],
     depth: &mut [u16],
     bound: &mut [u16],
     verts: &mut [Projected],
+    bins: &mut [u8],
     counter: &mut C,
     frames: core::ops::Range<usize>,
     mut on_band: impl FnMut(u16, &[u16]),
@@ -806,7 +823,13 @@ pub fn run_torus_bounded<R: SpanRecip, C: Counter>(
     for k in frames {
         let m = cam.model_matrix(&torus::model(k));
         counter.start();
-        let frame = r.transform_mesh(&mesh, &m, &vp, verts);
+        let frame = r.transform_mesh(&mesh, &m, &vp, verts).and_then(|f| {
+            if bins.is_empty() {
+                Ok(f)
+            } else {
+                r.bin_mesh(f, &mut *bins)
+            }
+        });
         instructions += counter.stop();
         let frame = frame?;
         let (i, b) = mesh_frame_in_bands(
@@ -838,16 +861,28 @@ pub fn run_torus_bounded<R: SpanRecip, C: Counter>(
 
 /// [`run_torus`] and its `bench` line (with `frames=8 instr_per_frame=`) or an `error` line; `false` on an error.
 /// Skipped (true) when the build-time `ONLY` names another scene.
+#[allow(clippy::too_many_arguments)]
 pub fn run_torus_line<R: SpanRecip, C: Counter>(
     board: &str,
     core: &str,
     color: &mut [u16],
     depth: &mut [u16],
     verts: &mut [Projected],
+    bins: &mut [u8],
     counter: &mut C,
     print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
-    run_torus_line_bounded::<R, C>(board, core, color, depth, &mut [], verts, counter, print)
+    run_torus_line_bounded::<R, C>(
+        board,
+        core,
+        color,
+        depth,
+        &mut [],
+        verts,
+        bins,
+        counter,
+        print,
+    )
 }
 
 /// [`run_torus_line`] with a coarse bound in `bound` ([`run_torus_bounded`]; empty: none).
@@ -859,6 +894,7 @@ pub fn run_torus_line_bounded<R: SpanRecip, C: Counter>(
     depth: &mut [u16],
     bound: &mut [u16],
     verts: &mut [Projected],
+    bins: &mut [u8],
     counter: &mut C,
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
@@ -870,6 +906,7 @@ pub fn run_torus_line_bounded<R: SpanRecip, C: Counter>(
         depth,
         bound,
         verts,
+        bins,
         counter,
         0..wraster::scenes::torus::FRAMES,
         |_, _| {},

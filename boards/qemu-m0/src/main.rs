@@ -3,7 +3,9 @@
 //! The frame does not fit in RAM: every standard scene is rendered in 30 bands of 8 rows (a 320x8 colour band and
 //! a 320x8 W16 band, 10 KiB), triangles binned by rows (see `wraster-board`), with the default reciprocal and with the previous-pixel seed, prints one `bench` line per
 //! run over semihosting and exits 0; any error or panic exits non-zero. `--features torus` builds W4 instead (the
-//! rotating torus through the mesh path, 60 bands of 4 rows: its 512 transformed vertices take 6 KiB of the 16).
+//! rotating torus through the mesh path, 60 bands of 4 rows: its 512 transformed vertices take 6 KiB of the 16, its
+//! row bins 1 KiB, and the deepest stack of the run, 3.5 KiB, leaves 0.5 KiB free: `boards/tools/stackdepth.c`, which
+//! CI runs on this build).
 //! Run: `cd boards/qemu-m0 && cargo run --release` (the runner in `.cargo/config.toml` adds `-icount shift=0`).
 //!
 //! Instructions are counted with SysTick on the 16 MHz core clock: one tick is exactly 62.5 instructions under
@@ -28,7 +30,10 @@ use wraster_board::run_all;
 use wraster_board::{run_scene, SCENES};
 use wraster_board::{SysTick, HEIGHT, WIDTH};
 #[cfg(feature = "torus")]
-use {wraster::mesh::Projected, wraster::scenes::torus::VERTICES};
+use {
+    wraster::mesh::Projected,
+    wraster::scenes::torus::{TRIANGLES, VERTICES},
+};
 
 /// Rows per band: the largest multiple of 8 whose two buffers leave room for the stack in 16 KiB.
 #[cfg(not(feature = "torus"))]
@@ -85,12 +90,16 @@ fn main() -> ! {
         y: 0.0,
         rhw: 0.0,
     }; VERTICES];
+    // The row bins (`Rasterizer::bin_mesh`, a byte per triangle): each of the 60 bands sets up only the triangles
+    // that can reach it.
+    static mut BINS: [u8; TRIANGLES] = [0; TRIANGLES];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
     fn torus<R: wraster::recip::SpanRecip>(
         color: &mut [u16],
         depth: &mut [u16],
         verts: &mut [Projected],
+        bins: &mut [u8],
         counter: &mut SysTick,
     ) -> bool {
         wraster_board::run_torus_line::<R, _>(
@@ -99,17 +108,18 @@ fn main() -> ! {
             color,
             depth,
             verts,
+            bins,
             counter,
             |line| hprintln!("{}", line),
         )
     }
-    let ok = torus::<Fast>(COLOR, DEPTH, VERTS, &mut counter);
+    let ok = torus::<Fast>(COLOR, DEPTH, VERTS, BINS, &mut counter);
     // `--features size-probe`: the default strategy only (profiles).
     #[cfg(not(feature = "size-probe"))]
     let ok = ok
-        & torus::<FastDiv>(COLOR, DEPTH, VERTS, &mut counter)
-        & torus::<Exact>(COLOR, DEPTH, VERTS, &mut counter)
-        & torus::<PrevPixel>(COLOR, DEPTH, VERTS, &mut counter);
+        & torus::<FastDiv>(COLOR, DEPTH, VERTS, BINS, &mut counter)
+        & torus::<Exact>(COLOR, DEPTH, VERTS, BINS, &mut counter)
+        & torus::<PrevPixel>(COLOR, DEPTH, VERTS, BINS, &mut counter);
     // `--features cull`: W4's build also measures the bounding-sphere cull (README: leaving work out at run time).
     #[cfg(feature = "cull")]
     let ok = ok
@@ -190,7 +200,7 @@ mod plan_buffers {
 use {
     plan_buffers::COLOR_LEN,
     wraster::mesh::Projected,
-    wraster_board::plans::{self, DEPTH_LEN, VERTS_LEN},
+    wraster_board::plans::{self, BINS_LEN, DEPTH_LEN, VERTS_LEN},
 };
 
 #[cfg(feature = "plan")]
@@ -203,6 +213,7 @@ fn main() -> ! {
         y: 0.0,
         rhw: 0.0,
     }; VERTS_LEN];
+    static mut BINS: [u8; BINS_LEN] = [0; BINS_LEN];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
     let ok = plans::run_all_plans(
@@ -211,6 +222,7 @@ fn main() -> ! {
         COLOR,
         DEPTH,
         VERTS,
+        BINS,
         &mut counter,
         &mut |a| hprintln!("{}", a),
     );

@@ -47,9 +47,17 @@ fn all<R: SpanRecip>(
         })
     }
     #[cfg(feature = "torus")]
-    run_torus_line::<R, _>("qemu-m4", "m4", color, depth, verts, counter, |line| {
-        hprintln!("{}", line)
-    })
+    // One band: nothing to bin (`&mut []`).
+    run_torus_line::<R, _>(
+        "qemu-m4",
+        "m4",
+        color,
+        depth,
+        verts,
+        &mut [],
+        counter,
+        |line| hprintln!("{}", line),
+    )
 }
 
 #[cfg(not(feature = "plan"))]
@@ -93,6 +101,7 @@ fn main() -> ! {
             DEPTH,
             BOUND,
             VERTS,
+            &mut [],
             &mut counter,
             |line| hprintln!("{}", line),
         );
@@ -130,7 +139,7 @@ fn main() -> ! {
 /// buffer is sized from the plans (none when no plan keeps depth) and the torus's vertex store is there only when a
 /// plan draws it, so `.bss` shows what a plan saves.
 #[cfg(feature = "plan")]
-use wraster_board::plans::{DEPTH_LEN, VERTS_LEN};
+use wraster_board::plans::{BINS_LEN, DEPTH_LEN, VERTS_LEN};
 #[cfg(feature = "plan")]
 const _: () = assert!(
     wraster_board::plans::COUNT > 0,
@@ -147,6 +156,7 @@ fn main() -> ! {
         y: 0.0,
         rhw: 0.0,
     }; VERTS_LEN];
+    static mut BINS: [u8; BINS_LEN] = [0; BINS_LEN];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 40, 1);
     let ok = wraster_board::plans::run_all_plans(
@@ -155,6 +165,7 @@ fn main() -> ! {
         COLOR,
         DEPTH,
         VERTS,
+        BINS,
         &mut counter,
         &mut |a| hprintln!("{}", a),
     );

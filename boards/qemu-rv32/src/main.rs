@@ -54,6 +54,7 @@ fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], verts: &mut [Projecte
         color,
         depth,
         verts,
+        &mut [], // one band: nothing to bin
         &mut Minstret(0),
         |line| hprintln!("{}", line),
     )

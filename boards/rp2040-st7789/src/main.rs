@@ -23,7 +23,7 @@ use rp2040_hal::gpio::{FunctionSpi, Pins};
 use rp2040_hal::{entry, pac, Sio, Spi, Timer, Watchdog};
 use wraster::mesh::Projected;
 use wraster::recip::Fast;
-use wraster::scenes::torus::VERTICES;
+use wraster::scenes::torus::{TRIANGLES, VERTICES};
 use wraster_board::{run_scene_with, run_torus_with, NoCounter, SCENES, WIDTH};
 
 /// The second-stage boot loader for the Pico's W25Q080 flash.
@@ -98,12 +98,15 @@ fn main() -> ! {
     };
     let _ = run_scene_with::<Fast, _>(terrain, &mut color, &mut depth, &mut NoCounter, &mut push);
     let mut verts = [Projected::default(); VERTICES];
+    // Row bins for the 15 bands (`Rasterizer::bin_mesh`): each band sets up only the triangles that can reach it.
+    let mut bins = [0u8; TRIANGLES];
     let mut k = 0;
     loop {
         let _ = run_torus_with::<Fast, _>(
             &mut color,
             &mut depth,
             &mut verts,
+            &mut bins,
             &mut NoCounter,
             k..k + 1,
             &mut push,
