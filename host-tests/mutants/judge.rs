@@ -8,6 +8,8 @@
 mod bad_input;
 #[path = "../tests/bias.rs"]
 mod bias;
+#[path = "../tests/bins.rs"]
+mod bins;
 #[path = "../tests/boundaries.rs"]
 mod boundaries;
 #[path = "../tests/clip.rs"]
