@@ -207,15 +207,18 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
         // Rows whose centre can be covered: y in [y0 + 0.5, y0 + h - 0.5], less 0.01 px of slack for the snap (which
         // moves y by at most 1/512 px) and the bounds' own rounding (below 2^-11 px for |y| < 2^12). Compared as
         // ordered integers (`key`): a float compare is a library call on a core without an FPU.
-        let rows = (key(y0 as f32 + 0.49), key((y0 + h as i32) as f32 - 0.49));
+        let rows = (
+            key(y0 as f32 + 0.49),
+            key(y0.saturating_add(h as i32) as f32 - 0.49),
+        );
         // A binned frame: the buckets of the top rows in [y0 - reach, y0 + h - 1], which hold every binned triangle
         // that can touch the band (its bottom is at least y0 and at most `reach` below its top); and the triangles to
         // clip. (One loop with one call of `triangle` for both kinds of frame: a second call site keeps LLVM from
         // inlining the draw into it, which costs the walk over all triangles 1% on the Cortex-M4's W4.)
         let (of, lo, span) = match self.bins.filter(|b| b.cull == cull) {
             Some(b) => {
-                let lo = b.bucket(y0 - b.reach);
-                (b.of, lo, b.bucket(y0 + h as i32 - 1) - lo)
+                let lo = b.bucket(y0.saturating_sub(b.reach));
+                (b.of, lo, b.bucket(y0.saturating_add(h as i32 - 1)) - lo)
             }
             None => (&[][..], 0, 0),
         };

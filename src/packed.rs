@@ -723,8 +723,9 @@ impl<R: WSpan> Rasterizer<R> {
             cmp: self.state.compare,
             write: self.state.depth_write,
         };
-        let inside =
-            |x: i32, y: i32| x >= 0 && x < width as i32 && y >= y0 && y < y0 + height as i32;
+        let inside = |x: i32, y: i32| {
+            x >= 0 && x < width as i32 && y >= y0 && (y as i64) < y0 as i64 + height as i64
+        };
         let mut stats = Stats::default();
         let mut put = |x: i32, y: i32| -> Result<(), Error> {
             stats.written += 1;

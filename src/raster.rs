@@ -280,7 +280,7 @@ impl<R: WSpan> Rasterizer<R> {
 
         let (j_first, j_last) = crate::edge::flat_rows(&p, rows_of(&p));
         let j0 = j_first.max(rows.0);
-        let j1 = j_last.min(rows.0 + rows.1 as i32 - 1);
+        let j1 = j_last.min(rows.0.saturating_add(rows.1 as i32 - 1)); // a band's last row (saturating: any y0)
         if j0 > j1 {
             return Ok(Err(Stats::default()));
         }
@@ -420,7 +420,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         let (first, last) = rows_of(&s.p);
         if R::FAST_W16
             && !s.on_grid
-            && first < depth.y0() + depth.height() as i32
+            && first <= depth.y0().saturating_add(depth.height() as i32 - 1)
             && last >= depth.y0()
         {
             s.fast_t = t_at_snapped(&s);

@@ -174,7 +174,7 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
     let pa = if area < 0 { [p[0], p[2], p[1]] } else { p };
     let (j_first, j_last) = flat_rows(&pa, rows_of(&pa));
     let j0 = j_first.max(depth.y0());
-    let j1 = j_last.min(depth.y0() + depth.height() as i32 - 1);
+    let j1 = j_last.min(depth.y0().saturating_add(depth.height() as i32 - 1));
     if j0 > j1 {
         return Ok(Some(Stats::default()));
     }

@@ -318,3 +318,101 @@ fn max_t_is_the_limit_the_checks_apply() {
         Err(Error::DepthRange)
     );
 }
+
+/// A band may start at any row `y0` (`DepthBuffer::band`, `Packed::band` take any `i32`): bands at the ends of the
+/// `i32` range, where `y0 + height` would overflow, draw nothing and do not panic, through the triangle paths (small
+/// and general), a packed format's triangles, lines and points, a world triangle and a mesh frame binned and not.
+#[test]
+fn bands_at_the_ends_of_the_row_range_draw_nothing() {
+    use wraster::clip::Viewport;
+    use wraster::format::W24F;
+    use wraster::mesh::{Colors, Mesh, Projected};
+    use wraster::projection::Camera;
+    use wraster::Packed;
+    let cam = Camera::look_at(
+        [3.0, 2.0, 5.0],
+        [0.0; 3],
+        [0.0, 1.0, 0.0],
+        1.0,
+        1.0,
+        0.5,
+        50.0,
+    )
+    .unwrap();
+    let (pos, idx) = host_tests::cube();
+    let mesh = Mesh {
+        positions: &pos,
+        indices: &idx,
+        colors: Colors::Uniform(Rgb565::RED),
+    };
+    let big = [
+        Vertex::new(-500.0, -500.0, 20.0, Rgb565::RED),
+        Vertex::new(900.0, -400.0, 200.0, Rgb565::RED),
+        Vertex::new(10.0, 900.0, 50.0, Rgb565::RED),
+    ];
+    for y0 in [
+        i32::MIN,
+        i32::MIN + 5,
+        -(1 << 30),
+        1 << 30,
+        i32::MAX - 5,
+        i32::MAX,
+    ] {
+        let mut r: Rasterizer = Rasterizer::new(cam.render_state().unwrap());
+        let mut frame = Frame::new(64, 48);
+        let mut data = vec![W16_FAR; 64 * 8];
+        let mut band = DepthBuffer::band(&mut data, 64, y0, 8).unwrap();
+        for tri in [good(), big] {
+            assert_eq!(
+                r.draw(&mut frame, &mut band, &tri).unwrap().written,
+                0,
+                "y0 {y0}"
+            );
+        }
+        let m = cam.matrix();
+        let vp = Viewport::new(0.0, 0.0, 64.0, 48.0);
+        let world = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]];
+        assert_eq!(
+            r.draw_world(&mut frame, &mut band, &m, &vp, &world, Rgb565::RED)
+                .unwrap()
+                .written,
+            0
+        );
+        let mut scratch = [Projected::default(); 8];
+        let mut bins = [0u8; 12];
+        let mf = r.transform_mesh(&mesh, &m, &vp, &mut scratch).unwrap();
+        assert_eq!(
+            r.draw_mesh_frame(&mut frame, &mut band, &mf)
+                .unwrap()
+                .written,
+            0
+        );
+        let mf = r.bin_mesh(mf, &mut bins).unwrap();
+        assert_eq!(
+            r.draw_mesh_frame(&mut frame, &mut band, &mf)
+                .unwrap()
+                .written,
+            0
+        );
+        let mut bytes = vec![0u8; 64 * 8 * 3];
+        let mut packed = Packed::<W24F>::band(&mut bytes, 64, y0, 8).unwrap();
+        for tri in [good(), big] {
+            let s = r.draw_format(&mut frame, Some(&mut packed), &tri).unwrap();
+            assert_eq!(s.written, 0, "y0 {y0}");
+        }
+        let line = [good()[0], good()[2]];
+        assert_eq!(
+            r.draw_line_format(&mut frame, Some(&mut packed), &line)
+                .unwrap()
+                .written,
+            0
+        );
+        assert_eq!(
+            r.draw_point_format(&mut frame, Some(&mut packed), &good()[1])
+                .unwrap()
+                .written,
+            0
+        );
+        assert!(frame.writes.iter().all(|&n| n == 0));
+    }
+}
