@@ -152,12 +152,14 @@ const CULLED: u8 = 255;
 
 impl Bins<'_> {
     /// A screen triangle's rows `(top, bottom)`, such that a band of rows `[y0, y0 + h)` whose test in
-    /// [`MeshFrame::triangle`] admits the triangle has `top <= y0 + h - 1` and `bottom >= y0`: `as i32` truncates
-    /// toward zero, so `|(y as i32) - y| < 1`, and `top < ymin <= y0 + h - 0.49`, `bottom > ymax >= y0 + 0.49`
-    /// (the test's bounds). (Without the margins this fails only for bands above row 0, where truncation rounds up.)
+    /// [`MeshFrame::triangle`] admits the triangle has `top <= y0 + h - 1` and `bottom >= y0` (the test admits it when
+    /// `ymin <= y0 + h - 0.49` and `ymax >= y0 + 0.49`). `as i32` truncates toward zero: `top = (ymin as i32) - 1`
+    /// is below `ymin` (truncation adds less than 1), so at most `y0 + h - 1`; `bottom = ymax as i32` is at least
+    /// `y0`, as truncation rounds a positive `ymax` down to an integer no smaller than `y0` and a negative one up.
+    /// (Without the `- 1`, a negative `ymin` rounded up misses bands above row 0.)
     #[inline]
     fn rows(ymin: f32, ymax: f32) -> (i32, i32) {
-        (ymin as i32 - 1, ymax as i32 + 1)
+        (ymin as i32 - 1, ymax as i32)
     }
     #[inline]
     fn bucket(&self, row: i32) -> u8 {
@@ -675,5 +677,88 @@ impl Sphere {
             || outside(sy, y, gy, yy, yw, ht - oy, 0.0) // screen y <= height
             || outside(0.0, 0.0, 0.0, 0.0, 0.0, 1.0, -range.near()) // W >= W_near
             || outside(0.0, 0.0, 0.0, 0.0, 0.0, -1.0, range.far())) // W <= W_far
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::recip::Fast;
+    use crate::RenderState;
+    use std::vec;
+    use std::vec::Vec;
+
+    /// The bins of a strip of 300 small triangles whose tops run from row -20 down 1.3 rows apart (a range of 390
+    /// rows: buckets of 2 rows), every fifth one back-facing, every seventh one with a vertex to clip: each kept
+    /// triangle's byte is the bucket of its top row `(trunc(ymin) - 1 - origin) >> 1`, the culled and clipped ones
+    /// carry their marks, and rows beyond the range clamp to the first and the last bucket.
+    #[test]
+    fn buckets_follow_the_top_rows() {
+        let n = 300usize;
+        let mut verts = Vec::new();
+        for k in 0..n {
+            let y = -20.0 + 1.3 * k as f32;
+            let (a, b) = ((10.0, y), (20.0, y + 0.5));
+            let c = (12.0, y + 3.5);
+            // Clockwise on the display (y down) is a positive area: `b` and `c` swapped for the back faces.
+            let (b, c) = if k.is_multiple_of(5) { (c, b) } else { (b, c) };
+            let rhw = if k % 7 == 3 { 0.0 } else { 0.5 };
+            for (x, y) in [a, b, c] {
+                verts.push(Projected { x, y, rhw });
+            }
+        }
+        let indices: Vec<[u16; 3]> = (0..n)
+            .map(|k| [3 * k as u16, 3 * k as u16 + 1, 3 * k as u16 + 2])
+            .collect();
+        let positions = [[0.0f32; 3]; 1];
+        let mesh = Mesh {
+            positions: &positions,
+            indices: &indices,
+            colors: Colors::Uniform(0u8),
+        };
+        let mut state = RenderState::new(1.0, 10.0).unwrap();
+        state.cull = Cull::Ccw;
+        let r = Rasterizer::<Fast>::new(state);
+        let vp = Viewport::new(0.0, 0.0, 64.0, 64.0);
+        let frame = MeshFrame {
+            mesh,
+            m: Mat4::translation([0.0; 3]),
+            planes: Planes::new(1.0, &vp).unwrap(),
+            verts: &verts,
+            bins: None,
+        };
+        let mut bytes = vec![0u8; n];
+        let binned = r.bin_mesh(frame, &mut bytes).unwrap();
+        let b = binned.bins.unwrap();
+        let kept = |k: usize| !k.is_multiple_of(5) && k % 7 != 3;
+        let top = |k: usize| (-20.0 + 1.3 * k as f32) as i32 - 1;
+        let origin = (0..n).filter(|&k| kept(k)).map(top).min().unwrap();
+        assert_eq!((b.origin, b.shift), (origin, 1));
+        // The reach: the tallest kept triangle's rows, 3.5 rows of y and the margin.
+        let reach = (0..n)
+            .filter(|&k| kept(k))
+            .map(|k| (-20.0 + 1.3 * k as f32 + 3.5) as i32 - top(k))
+            .max()
+            .unwrap();
+        assert_eq!(b.reach, reach);
+        let mut spread = std::collections::BTreeSet::new();
+        for k in 0..n {
+            let want = if k % 7 == 3 {
+                CLIP
+            } else if k.is_multiple_of(5) {
+                CULLED
+            } else {
+                ((top(k) - origin) >> 1) as u8
+            };
+            assert_eq!(b.of[k], want, "triangle {k}");
+            spread.insert(b.of[k]);
+        }
+        assert!(spread.len() > 150);
+        assert_eq!(
+            binned.binned_culled(),
+            Some((0..n).filter(|k| k.is_multiple_of(5) && k % 7 != 3).count() as u32)
+        );
+        assert_eq!((b.bucket(origin - 100), b.bucket(origin + 5)), (0, 2));
+        assert_eq!(b.bucket(origin + 10_000), (BUCKETS - 1) as u8);
     }
 }
