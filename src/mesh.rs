@@ -761,4 +761,58 @@ mod tests {
         assert_eq!((b.bucket(origin - 100), b.bucket(origin + 5)), (0, 2));
         assert_eq!(b.bucket(origin + 10_000), (BUCKETS - 1) as u8);
     }
+
+    /// A target that takes any pixel.
+    struct Null;
+    impl embedded_graphics_core::geometry::OriginDimensions for Null {
+        fn size(&self) -> embedded_graphics_core::geometry::Size {
+            embedded_graphics_core::geometry::Size::new(64, 64)
+        }
+    }
+    impl DrawTarget for Null {
+        type Color = embedded_graphics_core::pixelcolor::BinaryColor;
+        type Error = core::convert::Infallible;
+        fn draw_iter<I>(&mut self, _: I) -> Result<(), Self::Error>
+        where
+            I: IntoIterator<Item = embedded_graphics_core::Pixel<Self::Color>>,
+        {
+            Ok(())
+        }
+    }
+
+    /// A band's walk looks only at triangles whose rows can hold a covered centre of the band: a back face just above
+    /// the band (its lowest vertex 0.3 px above the band's first row, whose centres are 0.5 px below it) and one just
+    /// below are not counted as culled there, while one reaching into the band is.
+    #[test]
+    fn a_band_counts_only_the_triangles_it_can_reach() {
+        use embedded_graphics_core::pixelcolor::BinaryColor;
+        // Three triangles wound alike, and the cull mode that drops that winding.
+        let tri = |y0: f32, y1: f32| {
+            [(10.0, y0), (12.0, y1), (20.0, y0)].map(|(x, y)| Projected { x, y, rhw: 0.5 })
+        };
+        let verts: Vec<Projected> = [tri(5.0, 9.7), tri(14.3, 18.0), tri(8.0, 11.0)].concat();
+        let indices = [[0u16, 1, 2], [3, 4, 5], [6, 7, 8]];
+        let positions = [[0.0f32; 3]; 1];
+        let mesh = Mesh {
+            positions: &positions,
+            indices: &indices,
+            colors: Colors::Uniform(BinaryColor::On),
+        };
+        let area = screen_area(&verts[0], &verts[1], &verts[2]);
+        let mut state = RenderState::new(1.0, 10.0).unwrap();
+        state.cull = if area > 0.0 { Cull::Cw } else { Cull::Ccw };
+        let mut r = Rasterizer::<Fast>::new(state);
+        let vp = Viewport::new(0.0, 0.0, 64.0, 64.0);
+        let frame = MeshFrame {
+            mesh,
+            m: Mat4::translation([0.0; 3]),
+            planes: Planes::new(1.0, &vp).unwrap(),
+            verts: &verts,
+            bins: None,
+        };
+        let mut data = vec![0u16; 64 * 4];
+        let mut band = crate::DepthBuffer::band(&mut data, 64, 10, 4).unwrap();
+        let s = r.draw_mesh_frame(&mut Null, &mut band, &frame).unwrap();
+        assert_eq!(s.culled, 1, "{s:?}");
+    }
 }
