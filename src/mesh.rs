@@ -688,6 +688,18 @@ mod tests {
     use std::vec;
     use std::vec::Vec;
 
+    /// A frame of screen vertices given as they are (as `transform_mesh` would leave them), in a 64 x 64 viewport.
+    fn screen_frame<'a, C: Copy>(mesh: Mesh<'a, C>, verts: &'a [Projected]) -> MeshFrame<'a, C> {
+        let vp = Viewport::new(0.0, 0.0, 64.0, 64.0);
+        MeshFrame {
+            mesh,
+            m: Mat4::translation([0.0; 3]),
+            planes: Planes::new(1.0, &vp).unwrap(),
+            verts,
+            bins: None,
+        }
+    }
+
     /// The bins of a strip of 300 small triangles whose tops run from row -20 down 1.3 rows apart (a range of 390
     /// rows: buckets of 2 rows), every fifth one back-facing, every seventh one with a vertex to clip: each kept
     /// triangle's byte is the bucket of its top row `(trunc(ymin) - 1 - origin) >> 1`, the culled and clipped ones
@@ -719,14 +731,7 @@ mod tests {
         let mut state = RenderState::new(1.0, 10.0).unwrap();
         state.cull = Cull::Ccw;
         let r = Rasterizer::<Fast>::new(state);
-        let vp = Viewport::new(0.0, 0.0, 64.0, 64.0);
-        let frame = MeshFrame {
-            mesh,
-            m: Mat4::translation([0.0; 3]),
-            planes: Planes::new(1.0, &vp).unwrap(),
-            verts: &verts,
-            bins: None,
-        };
+        let frame = screen_frame(mesh, &verts);
         let mut bytes = vec![0u8; n];
         let binned = r.bin_mesh(frame, &mut bytes).unwrap();
         let b = binned.bins.unwrap();
@@ -802,14 +807,7 @@ mod tests {
         let mut state = RenderState::new(1.0, 10.0).unwrap();
         state.cull = if area > 0.0 { Cull::Cw } else { Cull::Ccw };
         let mut r = Rasterizer::<Fast>::new(state);
-        let vp = Viewport::new(0.0, 0.0, 64.0, 64.0);
-        let frame = MeshFrame {
-            mesh,
-            m: Mat4::translation([0.0; 3]),
-            planes: Planes::new(1.0, &vp).unwrap(),
-            verts: &verts,
-            bins: None,
-        };
+        let frame = screen_frame(mesh, &verts);
         let mut data = vec![0u16; 64 * 4];
         let mut band = crate::DepthBuffer::band(&mut data, 64, 10, 4).unwrap();
         let s = r.draw_mesh_frame(&mut Null, &mut band, &frame).unwrap();

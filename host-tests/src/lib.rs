@@ -637,6 +637,21 @@ pub fn render_torus_with<R: SpanRecip>(
     Ok((frame, depth, stats))
 }
 
+/// The camera the mesh tests view [`cube`] with: from `(3, 2, 5)` towards the origin, a field of view of 1 radian,
+/// square, depth planes 0.5 and 50.
+pub fn cube_camera() -> wraster::projection::Camera {
+    wraster::projection::Camera::look_at(
+        [3.0, 2.0, 5.0],
+        [0.0; 3],
+        [0.0, 1.0, 0.0],
+        1.0,
+        1.0,
+        0.5,
+        50.0,
+    )
+    .expect("a valid camera")
+}
+
 /// A cube from -1 to 1, twelve triangles, every face wound counter-clockwise seen from outside: a closed convex mesh.
 pub fn cube() -> ([[f32; 3]; 8], [[u16; 3]; 12]) {
     (

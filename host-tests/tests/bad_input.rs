@@ -327,18 +327,8 @@ fn bands_at_the_ends_of_the_row_range_draw_nothing() {
     use wraster::clip::Viewport;
     use wraster::format::W24F;
     use wraster::mesh::{Colors, Mesh, Projected};
-    use wraster::projection::Camera;
     use wraster::Packed;
-    let cam = Camera::look_at(
-        [3.0, 2.0, 5.0],
-        [0.0; 3],
-        [0.0, 1.0, 0.0],
-        1.0,
-        1.0,
-        0.5,
-        50.0,
-    )
-    .unwrap();
+    let cam = host_tests::cube_camera();
     let (pos, idx) = host_tests::cube();
     let mesh = Mesh {
         positions: &pos,

@@ -94,9 +94,8 @@ fn same_either_way(
     whole.stats.written
 }
 
-/// W4's eight frames, in bands of 1, 3, 4 (the Cortex-M0's), 7, 16 (the RP2040's) and 240 rows.
-#[test]
-fn binned_torus_frames_equal_the_unbinned() {
+/// W4's mesh, camera and render state, handed to `f`.
+fn with_torus<T>(f: impl FnOnce(&Mesh<'_, Rgb565>, &Camera, RenderState) -> T) -> T {
     let (pos, idx, col) = (torus::positions(), torus::indices(), torus::colors());
     let mesh = Mesh {
         positions: &pos,
@@ -105,11 +104,20 @@ fn binned_torus_frames_equal_the_unbinned() {
     };
     let cam = torus::camera().unwrap();
     let state = cam.render_state().unwrap();
-    for k in 0..torus::FRAMES {
-        let m = cam.model_matrix(&torus::model(k));
-        let written = same_either_way(&mesh, &m, state, (320, 240), &[1, 3, 4, 7, 16, 240], true);
-        assert!(written > 10_000, "frame {k}: {written} pixels");
-    }
+    f(&mesh, &cam, state)
+}
+
+/// W4's eight frames, in bands of 1, 3, 4 (the Cortex-M0's), 7, 16 (the RP2040's) and 240 rows.
+#[test]
+fn binned_torus_frames_equal_the_unbinned() {
+    with_torus(|mesh, cam, state| {
+        for k in 0..torus::FRAMES {
+            let m = cam.model_matrix(&torus::model(k));
+            let written =
+                same_either_way(mesh, &m, state, (320, 240), &[1, 3, 4, 7, 16, 240], true);
+            assert!(written > 10_000, "frame {k}: {written} pixels");
+        }
+    });
 }
 
 /// A xorshift64 generator.
@@ -177,26 +185,20 @@ fn binned_soups_with_clipping_equal_the_unbinned() {
 /// unbinned draw in the drawing mode.
 #[test]
 fn a_draw_that_culls_otherwise_ignores_the_bins() {
-    let (pos, idx, col) = (torus::positions(), torus::indices(), torus::colors());
-    let mesh = Mesh {
-        positions: &pos,
-        indices: &idx,
-        colors: Colors::PerFace(&col),
-    };
-    let cam = torus::camera().unwrap();
-    let state = cam.render_state().unwrap();
-    let mut none = state;
-    none.cull = Cull::None;
-    let m = cam.model_matrix(&torus::model(2));
-    for band in [4, 240] {
-        let binned_cw = draw(&mesh, &m, state, none, (320, 240), band, true).unwrap();
-        let plain_none = draw(&mesh, &m, none, none, (320, 240), band, false).unwrap();
-        assert!(binned_cw.frame == plain_none.frame && binned_cw.depth == plain_none.depth);
-        assert_eq!(binned_cw.stats.fragments, plain_none.stats.fragments);
-        // Drawing the back faces too changes the frame's fragments (else this test could not tell).
-        let plain_cw = draw(&mesh, &m, state, state, (320, 240), band, false).unwrap();
-        assert!(plain_cw.stats.fragments < plain_none.stats.fragments);
-    }
+    with_torus(|mesh, cam, state| {
+        let mut none = state;
+        none.cull = Cull::None;
+        let m = cam.model_matrix(&torus::model(2));
+        for band in [4, 240] {
+            let binned_cw = draw(mesh, &m, state, none, (320, 240), band, true).unwrap();
+            let plain_none = draw(mesh, &m, none, none, (320, 240), band, false).unwrap();
+            assert!(binned_cw.frame == plain_none.frame && binned_cw.depth == plain_none.depth);
+            assert_eq!(binned_cw.stats.fragments, plain_none.stats.fragments);
+            // Drawing the back faces too changes the frame's fragments (else this test could not tell).
+            let plain_cw = draw(mesh, &m, state, state, (320, 240), band, false).unwrap();
+            assert!(plain_cw.stats.fragments < plain_none.stats.fragments);
+        }
+    });
 }
 
 /// Bins shorter than the triangles are refused; a mesh wholly off screen bins and draws nothing.
@@ -208,16 +210,7 @@ fn short_bins_are_an_error_and_an_empty_view_draws_nothing() {
         indices: &idx,
         colors: Colors::Uniform(Rgb565::new(31, 0, 0)),
     };
-    let cam = Camera::look_at(
-        [3.0, 2.0, 5.0],
-        [0.0; 3],
-        [0.0, 1.0, 0.0],
-        1.0,
-        1.0,
-        0.5,
-        50.0,
-    )
-    .unwrap();
+    let cam = host_tests::cube_camera();
     let r = Rasterizer::<Fast>::new(cam.render_state().unwrap());
     let vp = Viewport::new(0.0, 0.0, 48.0, 48.0);
     let mut scratch = [Projected::default(); 8];
@@ -245,49 +238,44 @@ fn short_bins_are_an_error_and_an_empty_view_draws_nothing() {
 /// the rows of a triangle up rather than down: binned and unbinned bands of 1 to 5 rows agree on the torus.
 #[test]
 fn bands_above_row_zero_keep_every_triangle() {
-    let (pos, idx, col) = (torus::positions(), torus::indices(), torus::colors());
-    let mesh = Mesh {
-        positions: &pos,
-        indices: &idx,
-        colors: Colors::PerFace(&col),
-    };
-    let cam = torus::camera().unwrap();
-    let state = cam.render_state().unwrap();
-    let (w, h, top) = (160u16, 120u16, -60i32);
-    let vp = Viewport::new(0.0, top as f32, w as f32, h as f32);
-    for k in [1, 5] {
-        let m = cam.model_matrix(&torus::model(k));
-        let mut out = Vec::new();
-        for binned in [false, true] {
-            for band in [1u16, 2, 5] {
-                let r = Rasterizer::<Fast>::new(state);
-                let mut scratch = vec![Projected::default(); pos.len()];
-                let mut bins = vec![0u8; idx.len()];
-                let mut mf = r.transform_mesh(&mesh, &m, &vp, &mut scratch).unwrap();
-                if binned {
-                    mf = r.bin_mesh(mf, &mut bins).unwrap();
+    with_torus(|mesh, cam, state| {
+        let (w, h, top) = (160u16, 120u16, -60i32);
+        let vp = Viewport::new(0.0, top as f32, w as f32, h as f32);
+        for k in [1, 5] {
+            let m = cam.model_matrix(&torus::model(k));
+            let mut out = Vec::new();
+            for binned in [false, true] {
+                for band in [1u16, 2, 5] {
+                    let r = Rasterizer::<Fast>::new(state);
+                    let mut scratch = vec![Projected::default(); mesh.positions.len()];
+                    let mut bins = vec![0u8; mesh.indices.len()];
+                    let mut mf = r.transform_mesh(mesh, &m, &vp, &mut scratch).unwrap();
+                    if binned {
+                        mf = r.bin_mesh(mf, &mut bins).unwrap();
+                    }
+                    let mut d = Rasterizer::<Fast>::new(state);
+                    let mut frame = Frame::new(w as u32, h as u32);
+                    let mut depth = vec![0u16; w as usize * h as usize];
+                    let mut stats = Stats::default();
+                    for (i, rows) in depth.chunks_mut(w as usize * band as usize).enumerate() {
+                        let bh = (rows.len() / w as usize) as u16;
+                        let mut buf =
+                            DepthBuffer::band(rows, w, top + (i * band as usize) as i32, bh)
+                                .unwrap();
+                        buf.clear();
+                        let mut target = frame.translated(Point::new(0, -top));
+                        stats += d.draw_mesh_frame(&mut target, &mut buf, &mf).unwrap();
+                    }
+                    out.push((frame, depth, stats.fragments, stats.written));
                 }
-                let mut d = Rasterizer::<Fast>::new(state);
-                let mut frame = Frame::new(w as u32, h as u32);
-                let mut depth = vec![0u16; w as usize * h as usize];
-                let mut stats = Stats::default();
-                for (i, rows) in depth.chunks_mut(w as usize * band as usize).enumerate() {
-                    let bh = (rows.len() / w as usize) as u16;
-                    let mut buf =
-                        DepthBuffer::band(rows, w, top + (i * band as usize) as i32, bh).unwrap();
-                    buf.clear();
-                    let mut target = frame.translated(Point::new(0, -top));
-                    stats += d.draw_mesh_frame(&mut target, &mut buf, &mf).unwrap();
-                }
-                out.push((frame, depth, stats.fragments, stats.written));
+            }
+            assert!(out[0].3 > 1000, "frame {k}: the torus is not in this view");
+            for o in &out[1..] {
+                assert!(
+                    o.0 == out[0].0 && o.1 == out[0].1 && (o.2, o.3) == (out[0].2, out[0].3),
+                    "frame {k}"
+                );
             }
         }
-        assert!(out[0].3 > 1000, "frame {k}: the torus is not in this view");
-        for o in &out[1..] {
-            assert!(
-                o.0 == out[0].0 && o.1 == out[0].1 && (o.2, o.3) == (out[0].2, out[0].3),
-                "frame {k}"
-            );
-        }
-    }
+    });
 }

@@ -245,16 +245,7 @@ fn bands_equal_the_whole_frame() {
 #[test]
 fn bad_meshes_are_errors_and_write_nothing() {
     let (pos, idx) = host_tests::cube();
-    let cam = Camera::look_at(
-        [3.0, 2.0, 5.0],
-        [0.0; 3],
-        [0.0, 1.0, 0.0],
-        1.0,
-        1.0,
-        0.5,
-        50.0,
-    )
-    .unwrap();
+    let cam = host_tests::cube_camera();
     let vp = Viewport::new(0.0, 0.0, 48.0, 48.0);
     let mut frame = Frame::new(48, 48);
     let mut depth = vec![0u16; 48 * 48];
