@@ -700,71 +700,81 @@ mod tests {
         }
     }
 
-    /// The bins of a strip of 300 small triangles whose tops run from row -20 down 1.3 rows apart (a range of 390
-    /// rows: buckets of 2 rows), every fifth one back-facing, every seventh one with a vertex to clip: each kept
-    /// triangle's byte is the bucket of its top row `(trunc(ymin) - 1 - origin) >> 1`, the culled and clipped ones
-    /// carry their marks, and rows beyond the range clamp to the first and the last bucket.
+    /// The bins of strips of small triangles whose tops run down 1.3 rows apart, every fifth one back-facing, every
+    /// seventh one with a vertex to clip: 300 from row -20 (a range of 390 rows: buckets of 2 rows), 150 from row 100
+    /// (193 rows: a bucket per row) and one alone. Each kept triangle's byte is the bucket of its top row
+    /// `(trunc(ymin) - 1 - origin) >> shift`, with `origin` the least top row and `shift` the least that brings the
+    /// range under 254 buckets; the culled and clipped ones carry their marks; rows beyond the range clamp to the first
+    /// and the last bucket.
     #[test]
     fn buckets_follow_the_top_rows() {
-        let n = 300usize;
-        let mut verts = Vec::new();
-        for k in 0..n {
-            let y = -20.0 + 1.3 * k as f32;
-            let (a, b) = ((10.0, y), (20.0, y + 0.5));
-            let c = (12.0, y + 3.5);
-            // Clockwise on the display (y down) is a positive area: `b` and `c` swapped for the back faces.
-            let (b, c) = if k.is_multiple_of(5) { (c, b) } else { (b, c) };
-            let rhw = if k % 7 == 3 { 0.0 } else { 0.5 };
-            for (x, y) in [a, b, c] {
-                verts.push(Projected { x, y, rhw });
+        for (start, n, want_shift) in [(-20.0f32, 300usize, 1u32), (100.0, 150, 0), (37.2, 1, 0)] {
+            let mut verts = Vec::new();
+            let culls = |k: usize| k % 5 == 4;
+            let clips = |k: usize| k % 7 == 3;
+            for k in 0..n {
+                let y = start + 1.3 * k as f32;
+                let (a, b) = ((10.0, y), (20.0, y + 0.5));
+                let c = (12.0, y + 3.5);
+                // Clockwise on the display (y down) is a positive area: `b` and `c` swapped for the back faces.
+                let (b, c) = if culls(k) { (c, b) } else { (b, c) };
+                let rhw = if clips(k) { 0.0 } else { 0.5 };
+                for (x, y) in [a, b, c] {
+                    verts.push(Projected { x, y, rhw });
+                }
             }
-        }
-        let indices: Vec<[u16; 3]> = (0..n)
-            .map(|k| [3 * k as u16, 3 * k as u16 + 1, 3 * k as u16 + 2])
-            .collect();
-        let positions = [[0.0f32; 3]; 1];
-        let mesh = Mesh {
-            positions: &positions,
-            indices: &indices,
-            colors: Colors::Uniform(0u8),
-        };
-        let mut state = RenderState::new(1.0, 10.0).unwrap();
-        state.cull = Cull::Ccw;
-        let r = Rasterizer::<Fast>::new(state);
-        let frame = screen_frame(mesh, &verts);
-        let mut bytes = vec![0u8; n];
-        let binned = r.bin_mesh(frame, &mut bytes).unwrap();
-        let b = binned.bins.unwrap();
-        let kept = |k: usize| !k.is_multiple_of(5) && k % 7 != 3;
-        let top = |k: usize| (-20.0 + 1.3 * k as f32) as i32 - 1;
-        let origin = (0..n).filter(|&k| kept(k)).map(top).min().unwrap();
-        assert_eq!((b.origin, b.shift), (origin, 1));
-        // The reach: the tallest kept triangle's rows, 3.5 rows of y and the margin.
-        let reach = (0..n)
-            .filter(|&k| kept(k))
-            .map(|k| (-20.0 + 1.3 * k as f32 + 3.5) as i32 - top(k))
-            .max()
-            .unwrap();
-        assert_eq!(b.reach, reach);
-        let mut spread = std::collections::BTreeSet::new();
-        for k in 0..n {
-            let want = if k % 7 == 3 {
-                CLIP
-            } else if k.is_multiple_of(5) {
-                CULLED
-            } else {
-                ((top(k) - origin) >> 1) as u8
+            let indices: Vec<[u16; 3]> = (0..n)
+                .map(|k| [3 * k as u16, 3 * k as u16 + 1, 3 * k as u16 + 2])
+                .collect();
+            let positions = [[0.0f32; 3]; 1];
+            let mesh = Mesh {
+                positions: &positions,
+                indices: &indices,
+                colors: Colors::Uniform(0u8),
             };
-            assert_eq!(b.of[k], want, "triangle {k}");
-            spread.insert(b.of[k]);
+            let mut state = RenderState::new(1.0, 10.0).unwrap();
+            state.cull = Cull::Ccw;
+            let r = Rasterizer::<Fast>::new(state);
+            let frame = screen_frame(mesh, &verts);
+            let mut bytes = vec![0u8; n];
+            let binned = r.bin_mesh(frame, &mut bytes).unwrap();
+            let b = binned.bins.unwrap();
+            let kept = |k: &usize| !culls(*k) && !clips(*k);
+            let top = |k: usize| (start + 1.3 * k as f32) as i32 - 1;
+            let origin = (0..n).filter(kept).map(top).min().unwrap();
+            let range = (0..n).filter(kept).map(top).max().unwrap() - origin;
+            let shift = (0..).find(|&s| range >> s < 254).unwrap();
+            assert_eq!(
+                (b.origin, b.shift, shift),
+                (origin, want_shift, want_shift),
+                "from {start}"
+            );
+            // The reach: the tallest kept triangle's rows, 3.5 rows of y and the margin.
+            let reach = (0..n)
+                .filter(kept)
+                .map(|k| (start + 1.3 * k as f32 + 3.5) as i32 - top(k))
+                .max()
+                .unwrap();
+            assert_eq!(b.reach, reach);
+            let mut spread = std::collections::BTreeSet::new();
+            for k in 0..n {
+                let want = if clips(k) {
+                    CLIP
+                } else if culls(k) {
+                    CULLED
+                } else {
+                    ((top(k) - origin) >> shift) as u8
+                };
+                assert_eq!(b.of[k], want, "from {start}: triangle {k}");
+                spread.insert(b.of[k]);
+            }
+            assert!(spread.len() >= n / 2, "from {start}");
+            let culled = (0..n).filter(|&k| culls(k) && !clips(k)).count() as u32;
+            assert_eq!(binned.binned_culled(), Some(culled));
+            assert_eq!(b.bucket(origin - 100), 0);
+            assert_eq!(b.bucket(origin + 5), (5 >> shift) as u8);
+            assert_eq!(b.bucket(origin + 10_000), (BUCKETS - 1) as u8);
         }
-        assert!(spread.len() > 150);
-        assert_eq!(
-            binned.binned_culled(),
-            Some((0..n).filter(|k| k.is_multiple_of(5) && k % 7 != 3).count() as u32)
-        );
-        assert_eq!((b.bucket(origin - 100), b.bucket(origin + 5)), (0, 2));
-        assert_eq!(b.bucket(origin + 10_000), (BUCKETS - 1) as u8);
     }
 
     /// A target that takes any pixel.
