@@ -395,6 +395,10 @@ impl<R: WSpan> Rasterizer<R> {
     /// triangles culled here ([`MeshFrame::binned_culled`]). A draw whose render state culls otherwise than this
     /// rasterizer's walks every triangle, as an unbinned frame does. Error: [`Error::BufferSize`] for `bins` shorter
     /// than the triangles.
+    ///
+    /// The bins are a slice the caller sizes to its mesh, not a `heapless` collection: a byte per triangle, indexed
+    /// by triangle, with no count to keep, and a capacity that is the mesh's, known where the mesh is (a firmware's
+    /// `static` beside its vertices), not fixed in the crate.
     pub fn bin_mesh<'a, C: Copy>(
         &self,
         frame: MeshFrame<'a, C>,
