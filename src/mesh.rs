@@ -259,11 +259,7 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
     ) -> Result<(), E> {
         let idx = tri.map(|i| i as usize);
         let [a, b, c] = idx.map(|i| self.verts[i]);
-        // rhw > 0, as integers (positive floats have positive bit patterns; 0 marks a vertex to clip)
-        if (a.rhw.to_bits() as i32) > 0
-            && (b.rhw.to_bits() as i32) > 0
-            && (c.rhw.to_bits() as i32) > 0
-        {
+        if on_screen(&[a, b, c]) {
             let (ka, kb, kc) = (key(a.y), key(b.y), key(c.y));
             if ka.max(kb).max(kc) < top || ka.min(kb).min(kc) > bottom {
                 return Ok(());
@@ -308,6 +304,19 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
         }
         Ok(())
     }
+}
+
+/// Whether all three vertices were mapped to the screen by `transform_mesh` (`rhw > 0`, compared as integers:
+/// positive floats have positive bit patterns, and 0 marks a vertex to clip).
+#[inline]
+fn on_screen(v: &[Projected; 3]) -> bool {
+    v.iter().all(|p| (p.rhw.to_bits() as i32) > 0)
+}
+
+/// A screen triangle's vertices `k` of `frame`.
+#[inline]
+fn screen_tri<C>(frame: &MeshFrame<'_, C>, k: usize) -> [Projected; 3] {
+    frame.mesh.indices[k].map(|i| frame.verts[i as usize])
 }
 
 /// The screen area of a triangle (doubled; y down: positive is clockwise on the display).
@@ -413,9 +422,8 @@ impl<R: WSpan> Rasterizer<R> {
         }
         let of = &mut bins[..n];
         let cull = self.state.cull;
-        // The rows of screen triangle `k` (its vertices' least and greatest y picked by `key`: no float compare).
-        let rows = |k: usize| {
-            let [a, b, c] = frame.mesh.indices[k].map(|i| frame.verts[i as usize]);
+        // The rows of a screen triangle (its vertices' least and greatest y picked by `key`: no float compare).
+        let rows = |[a, b, c]: [Projected; 3]| {
             let (ka, kb, kc) = (key(a.y), key(b.y), key(c.y));
             let ymin = if ka <= kb && ka <= kc {
                 a.y
@@ -436,16 +444,13 @@ impl<R: WSpan> Rasterizer<R> {
         // First pass: cull, and the top rows' range and the reach of the triangles kept on screen (marked 0).
         let (mut lo, mut hi, mut reach, mut culled_n) = (i32::MAX, i32::MIN, 0, 0u32);
         for (k, b) in of.iter_mut().enumerate() {
-            let [p, q, r] = frame.mesh.indices[k].map(|i| frame.verts[i as usize]);
-            *b = if (p.rhw.to_bits() as i32) > 0
-                && (q.rhw.to_bits() as i32) > 0
-                && (r.rhw.to_bits() as i32) > 0
-            {
-                if culled(cull, screen_area(&p, &q, &r)) {
+            let v = screen_tri(&frame, k);
+            *b = if on_screen(&v) {
+                if culled(cull, screen_area(&v[0], &v[1], &v[2])) {
                     culled_n += 1;
                     CULLED
                 } else {
-                    let (top, bottom) = rows(k);
+                    let (top, bottom) = rows(v);
                     (lo, hi, reach) = (lo.min(top), hi.max(top), reach.max(bottom - top));
                     0
                 }
@@ -472,7 +477,7 @@ impl<R: WSpan> Rasterizer<R> {
         // Second pass: the bucket of each kept triangle's top row.
         for (k, b) in of.iter_mut().enumerate() {
             if *b == 0 {
-                *b = bins.bucket(rows(k).0);
+                *b = bins.bucket(rows(screen_tri(&frame, k)).0);
             }
         }
         bins.of = of;
