@@ -932,7 +932,7 @@ mod tests {
             divide.0,
             divide.1
         );
-        assert_eq!(chord, (0x54f8_e264_5787_2938, 1_743_640));
+        assert_eq!(chord, (0x3ded_b611_72f7_c422, 1_743_640));
         assert_eq!(divide, (0x25dc_8ce4_8381_4fcb, 1_743_640));
     }
 }
