@@ -745,19 +745,20 @@ fn fresh_run<const UP: bool, S: FreshSeed>(
     round: u32,
     s: u32,
 ) -> (usize, u64, End) {
-    // The pixel count comes from the iterator's remaining length on leaving: no counter beside the pointer.
     let n = row.len();
-    let mut it = row.iter_mut();
-    while let Some(stored) = it.next() {
+    let mut k = 0;
+    while k < n {
         let x = fresh::<UP, S>((v >> 32) as u32);
-        let c = ((x as u32).wrapping_add(round) >> s) as u16;
-        if c >= *stored {
-            return (n - it.len() - 1, v, End::Fail);
+        // Compared as a `u32` (no zero-extension); `x <= 2^30 (1 + 2^-27)`, so the code fits 16 bits.
+        let c = (x as u32).wrapping_add(round) >> s;
+        if c >= row[k] as u32 {
+            return (k, v, End::Fail);
         }
-        *stored = c;
+        row[k] = c as u16;
+        k += 1;
         v = v.wrapping_add(dv);
         if left_binade::<UP>(v) {
-            return (n - it.len(), v, End::Binade);
+            return (k, v, End::Binade);
         }
     }
     (n, v, End::Row)
