@@ -64,7 +64,7 @@ impl Viewport {
 }
 
 /// Guard band used for clipping, pixels (inside [`crate::GUARD_BAND`]).
-const CLIP_BAND: f32 = 4000.0;
+pub(crate) const CLIP_BAND: f32 = 4000.0;
 /// Up to 3 + one vertex per plane (5 planes).
 const MAX_VERTS: usize = 8;
 
@@ -137,6 +137,16 @@ impl Planes {
             zmin: vp.min_z,
             zscale: vp.max_z - vp.min_z,
         })
+    }
+
+    /// The viewport map's constants `(sx, sy, ox, oy)`: screen `x = ox + (x/w) sx`, `y = oy - (y/w) sy`.
+    pub(crate) fn map_constants(&self) -> (f32, f32, f32, f32) {
+        (self.sx, self.sy, self.ox, self.oy)
+    }
+
+    /// `W_near`.
+    pub(crate) fn near(&self) -> f32 {
+        self.near
     }
 
     /// Signed distance of `c` to plane `p` (inside when `>= 0`): the near W plane, then the guard band's four.

@@ -133,6 +133,7 @@ pub mod recip;
 pub mod scenes;
 mod small;
 mod state;
+mod transform;
 
 #[cfg(feature = "coarse")]
 pub use depth::bound_len;

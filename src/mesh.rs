@@ -80,6 +80,7 @@ use embedded_graphics_core::pixelcolor::PixelColor;
 use crate::clip::{check_matrix, fan, to_clip, Planes, Viewport};
 use crate::projection::Mat4;
 use crate::recip::{SpanRecip, WSpan};
+use crate::transform::IntTransform;
 use crate::{Cull, DepthBuffer, Error, Rasterizer, Stats, Vertex};
 
 /// The colours of a mesh.
@@ -375,14 +376,21 @@ impl<R: WSpan> Rasterizer<R> {
         }
         check_matrix(m)?;
         let planes = Planes::new(self.state.range.near(), vp)?;
-        for (p, s) in mesh.positions.iter().zip(scratch.iter_mut()) {
-            let c = to_clip(m, p)?;
-            *s = if planes.outcode(&c) == 0 {
-                let [x, y, _, rhw] = planes.map_checked(&c)?;
-                Projected { x, y, rhw }
-            } else {
-                Projected::default()
-            };
+        if R::INTEGER_TRANSFORM {
+            let it = IntTransform::new(m, &planes, mesh.positions)?;
+            for (p, s) in mesh.positions.iter().zip(scratch.iter_mut()) {
+                *s = it.project(p)?.unwrap_or_default();
+            }
+        } else {
+            for (p, s) in mesh.positions.iter().zip(scratch.iter_mut()) {
+                let c = to_clip(m, p)?;
+                *s = if planes.outcode(&c) == 0 {
+                    let [x, y, _, rhw] = planes.map_checked(&c)?;
+                    Projected { x, y, rhw }
+                } else {
+                    Projected::default()
+                };
+            }
         }
         Ok(MeshFrame {
             mesh: *mesh,

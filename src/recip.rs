@@ -236,8 +236,13 @@ pub trait SpanRecip: Default {
     /// Whether W16 spans with the `Less` test take the fast tier's loop (`crate::fast`) instead of this reciprocal.
     const FAST_W16: bool = false;
     /// With [`SpanRecip::FAST_W16`]: whether the fast tier's fresh reciprocal is seeded by one 32-bit division
-    /// ([`FastDiv`]) instead of a 128-cell table ([`Fast`]).
+    /// ([`FastDiv`]) instead of a 256-cell table ([`Fast`]).
     const DIV_SEED: bool = false;
+    /// Whether [`crate::Rasterizer::transform_mesh`] transforms vertices in integer arithmetic (for cores without an
+    /// FPU: no float operation per vertex; see the crate's `transform` module) rather than in f32. The strategy
+    /// carries it, like the reciprocal, so that each strategy's frames are the same on every core: [`Fast`] (the
+    /// Cortex-M0's default) takes the integer transform; the others f32 (the M4F's FPU does it in fewer instructions).
+    const INTEGER_TRANSFORM: bool = false;
     /// Before the first pixel of a span; `smooth` as defined at [`SMOOTH_SHIFT`].
     #[inline(always)]
     fn begin_span(&mut self, _smooth: bool) {}
@@ -281,6 +286,7 @@ impl SpanRecip for Fast {
     const MAX_REL_ERROR: f64 =
         crate::fast::FAST_MAX_REL_ERROR.max(PerPixel::<DefaultRecip>::MAX_REL_ERROR);
     const FAST_W16: bool = true;
+    const INTEGER_TRANSFORM: bool = true;
     #[inline(always)]
     fn recip(&mut self, m: u32) -> u32 {
         DefaultRecip::recip(m)
@@ -289,7 +295,7 @@ impl SpanRecip for Fast {
 
 /// The fast tier seeded by division, for cores with a divide instruction (Cortex-M3/M4/M7, RV32IM): the same loops,
 /// bound and contract as [`Fast`], with the fresh reciprocal's seed `2^13 floor((2^32 - 1) / floor(m / 2^16))` (one
-/// `UDIV`, below `2^-15 (1 + 2^-14)`) instead of the 128-cell table (below `2^-14.8`): fewer instructions a fresh
+/// `UDIV`, below `2^-15 (1 + 2^-14)`) instead of the 256-cell table and half-word step: fewer instructions a fresh
 /// pixel and no table in flash. Its frames differ from [`Fast`]'s in rare last-bit roundings, and are the same on
 /// every core (on the Cortex-M0, which has no divide instruction, the division is a library call: correct, slow).
 #[derive(Default)]
@@ -441,6 +447,8 @@ pub fn exact_u(t: u64, frac: u32) -> u64 {
 pub trait WSpan: Default {
     /// Short name for reports.
     const NAME: &'static str;
+    /// Whether meshes are transformed in integer arithmetic ([`SpanRecip::INTEGER_TRANSFORM`]).
+    const INTEGER_TRANSFORM: bool = false;
     /// Walks a span of `n >= 1` pixels whose `T` starts at `t0` and steps by `dt`, calling `px(k, Some(u))` for each
     /// pixel `k` whose `T` lies in `[lo, hi]` (`lo = 2^frac`, the far plane) and `px(k, None)` for the others, in order.
     #[allow(clippy::too_many_arguments)]
@@ -464,6 +472,7 @@ fn ends_in(t0: u64, dt: i64, n: usize, lo: u64, hi: u64) -> bool {
 }
 
 impl<R: SpanRecip> WSpan for R {
+    const INTEGER_TRANSFORM: bool = R::INTEGER_TRANSFORM;
     const NAME: &'static str = R::NAME;
     #[inline(always)]
     fn walk<E>(

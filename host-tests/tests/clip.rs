@@ -10,6 +10,7 @@
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
 use host_tests::Frame;
 use wraster::clip::Viewport;
+use wraster::mesh::{Colors, Mesh, Projected};
 use wraster::projection::{is_w_friendly, Mat4};
 use wraster::{DepthBuffer, Rasterizer, RenderState, W16_FAR};
 
@@ -113,18 +114,49 @@ fn check(t: [[f32; 3]; 3]) -> (usize, usize) {
 }
 
 /// [`check`] with the near plane at `near`; also returns how many covered pixels were compared and how many of them
-/// hold the correctly rounded code.
+/// hold the correctly rounded code. The triangle is drawn twice, each checked on its own: by `draw_world` (the f32
+/// transform and clip), and as a one-triangle mesh by `draw_mesh` with the default strategy, whose vertices in front
+/// of the near plane and inside the guard band take the integer transform (`wraster::recip::SpanRecip::
+/// INTEGER_TRANSFORM`; its error is inside the f32 path's, so the same bounds apply) and whose others the f32 clip.
 fn check_near(t: [[f32; 3]; 3], near: f64) -> (usize, usize, usize, usize) {
     let m = projection_near(near);
     assert!(is_w_friendly(&m));
     let vp = Viewport::new(0.0, 0.0, W as f32, H as f32);
-    let mut frame = Frame::new(W as u32, H as u32);
-    let mut depth = vec![0u16; W as usize * H as usize];
-    let mut buf = DepthBuffer::new(&mut depth, W, H).unwrap();
-    buf.clear();
     let mut r: Rasterizer = Rasterizer::new(RenderState::new(near as f32, FAR as f32).unwrap());
-    r.draw_world(&mut frame, &mut buf, &m, &vp, &t, Rgb565::WHITE)
+    let mut world = (
+        Frame::new(W as u32, H as u32),
+        vec![0u16; W as usize * H as usize],
+    );
+    let mut buf = DepthBuffer::new(&mut world.1, W, H).unwrap();
+    buf.clear();
+    r.draw_world(&mut world.0, &mut buf, &m, &vp, &t, Rgb565::WHITE)
         .unwrap();
+    let mut mesh = (
+        Frame::new(W as u32, H as u32),
+        vec![0u16; W as usize * H as usize],
+    );
+    let mut buf = DepthBuffer::new(&mut mesh.1, W, H).unwrap();
+    buf.clear();
+    let one = Mesh {
+        positions: &t,
+        indices: &[[0, 1, 2]],
+        colors: Colors::Uniform(Rgb565::WHITE),
+    };
+    let mut scratch = [Projected::default(); 3];
+    r.draw_mesh(&mut mesh.0, &mut buf, &one, &m, &vp, &mut scratch)
+        .unwrap();
+    let a = compare(t, near, &world.0, &world.1);
+    let b = compare(t, near, &mesh.0, &mesh.1);
+    (a.0 + b.0, a.1 + b.1, a.2 + b.2, a.3 + b.3)
+}
+
+/// One drawn frame of `t` against the ray caster: (pixels drawn, compared, covered and compared, exact).
+fn compare(
+    t: [[f32; 3]; 3],
+    near: f64,
+    frame: &Frame,
+    depth: &[u16],
+) -> (usize, usize, usize, usize) {
     let tf = t.map(|v| v.map(|c| c as f64));
     let (mut drawn, mut compared, mut exact, mut covered) = (0, 0, 0, 0);
     for py in 0..H as usize {

@@ -32,7 +32,7 @@ const GOLDEN: &[(&str, &str, u64, u32, u32)] = &[
     ("terrain", "fast-div", 0xb775bf05e2881a11, 56244, 70838),
     ("terrain", "lerp64", 0xb775bf05e2881a11, 56244, 70838),
     ("terrain", "prev-pixel", 0xb775bf05e2881a11, 56244, 70838),
-    ("torus", "fast", 0xfa9f95e2bd2419c9, 147323, 152060),
+    ("torus", "fast", 0xcf6cdd0d1dc65495, 147323, 152060),
     ("torus", "fast-div", 0x5dd7a2400c38913e, 147323, 152060),
     ("torus", "lerp64", 0xfa9f95e2bd2419c9, 147323, 152060),
     ("torus", "prev-pixel", 0x0794973605377561, 147323, 152060),

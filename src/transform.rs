@@ -1,0 +1,380 @@
+//! The mesh vertex transform in integer arithmetic, for cores without an FPU: no float operation per vertex (the
+//! Cortex-M0's soft-float multiply alone calls a 64-bit multiply, about 100 instructions; a vertex took about 5,600),
+//! and the same bits on every core.
+//!
+//! **Formats** (chosen once per frame, block floating point). The positions share one exponent `P`: every coordinate
+//! is below `2^P` and is held as `round(p 2^(30 - P))`, an `i32` of at most 31 bits (exact for any coordinate within
+//! `2^7` of the largest: an f32 has 24 bits). Each output row (the viewport map folded into the matrix: `X' = sx X +
+//! ox W`, `Y' = -sy Y + oy W`, and `W`) has its own exponent `e`: its three linear entries, held as `round(a
+//! 2^(30 - e))`, are below `2^30`, and its translation, held as `round(t 2^(60 - P - e))`, below `2^60`. A row's value
+//! is then `sum_j A_j P_j + T` exactly, in `i64` (below `3 2^60 + 2^60 = 2^62`), in units of `2^(P + e - 60)`. The
+//! scales change per frame with the mesh and the matrix, so the values are raw integers beside their exponents rather
+//! than the `fixed` crate's types, whose fraction bits are fixed at compile time.
+//!
+//! **Projection.** With `W` at least `W_near` (else the vertex is marked for clipping, as the f32 path marks it),
+//! `rhw = 1/W` and `x = X'/W`, `y = Y'/W` come from one reciprocal of `W`'s top 32 bits (the fast tier's,
+//! `2^-27.9`) and one 32 x 32 -> 64 product each, rounded once to f32 (to nearest, even). A vertex whose `x` or `y`
+//! lies beyond the clip guard band (`4000` px) is marked for clipping.
+//!
+//! **Error** against exact arithmetic on the given f32 positions and matrix: the viewport folded in f32 (two products
+//! and a sum per entry, `3 2^-24` of the larger term, once per frame); the positions' and entries' roundings to
+//! 31 bits (`2^-31` of the largest term each); the reciprocal `2^-27.9`, `W`'s and `X'`'s top 32 bits `2^-31` each;
+//! the final f32 rounding `2^-24`. A screen position is within about `|x_px| 2^-22` px (`8e-5` px at 320 px) and `rhw`
+//! within `2^-23.8` relative: inside the f32 path's own bound (`crate::clip::Planes`), which the ray-caster tests
+//! (`host-tests/tests/mesh.rs`) allow for.
+
+use crate::clip::{Planes, CLIP_BAND};
+use crate::fast::{bits64, fresh61, mul_wide, Chord};
+use crate::fixed::{round_shift, split};
+use crate::mesh::Projected;
+use crate::projection::Mat4;
+use crate::Error;
+
+/// One output row: `A_j` for the three coordinates, `T`, and the row's exponent `e`.
+#[derive(Clone, Copy, Debug)]
+struct Row {
+    a: [i32; 3],
+    t: i64,
+    e: i32,
+}
+
+/// A frame's integer transform: the three rows (`X'`, `Y'`, `W`), the positions' exponent, and `W_near` in `W`'s
+/// units.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct IntTransform {
+    rows: [Row; 3],
+    p: i32,
+    /// The smallest `W` (in its row's units) at or above `W_near`: `ceil(W_near / u_W)`, saturated.
+    near: i64,
+}
+
+/// `round(v 2^s)` as a signed `i64` for `|v 2^s| <= 2^62` (the callers' bounds), from an f32's exact split.
+fn scaled(v: f32, s: i32) -> i64 {
+    let (neg, m, e) = split(v).unwrap_or((false, 0, 0));
+    let r = round_shift(m as u64, e + s) as i64;
+    if neg {
+        -r
+    } else {
+        r
+    }
+}
+
+/// The exponent `b` with `|v| < 2^b` for a finite f32 (`i32::MIN` for 0): its mantissa's bits above its exponent.
+fn magnitude(v: f32) -> i32 {
+    match split(v) {
+        Some((_, m, e)) if m != 0 => e + (32 - m.leading_zeros() as i32),
+        _ => i32::MIN,
+    }
+}
+
+impl IntTransform {
+    /// The frame's formats for `positions` (all finite) under `m` (finite) and `planes`' viewport. [`Error::NonFinite`]
+    /// for a non-finite position; [`Error::WorldTooLarge`] when folding the viewport into the matrix overflows f32.
+    pub(crate) fn new(
+        m: &Mat4,
+        planes: &Planes,
+        positions: &[[f32; 3]],
+    ) -> Result<IntTransform, Error> {
+        let mut p = i32::MIN;
+        for v in positions.iter().flatten() {
+            if !v.is_finite() {
+                return Err(Error::NonFinite);
+            }
+            p = p.max(magnitude(*v));
+        }
+        // All positions zero (or none): any exponent works.
+        let p = if p == i32::MIN { 0 } else { p };
+        // Column `i` of `m` is output `i`: c_i = sum_j q_j m[j][i] + m[3][i].
+        let col = |i: usize| [m.0[0][i], m.0[1][i], m.0[2][i], m.0[3][i]];
+        let (cx, cy, cw) = (col(0), col(1), col(3));
+        let (sx, sy, ox, oy) = planes.map_constants();
+        let fold_x: [f32; 4] = core::array::from_fn(|j| sx * cx[j] + ox * cw[j]);
+        let fold_y: [f32; 4] = core::array::from_fn(|j| oy * cw[j] - sy * cy[j]);
+        let rows_f = [fold_x, fold_y, cw];
+        if rows_f.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(Error::WorldTooLarge);
+        }
+        let rows = rows_f.map(|r| {
+            // |a_j| < 2^e and |t| < 2^(e + p); at least one bit above the lowest f32 exponent keeps the shifts sane.
+            let e = (0..3)
+                .map(|j| magnitude(r[j]))
+                .chain([magnitude(r[3]).saturating_sub(p)])
+                .max()
+                .unwrap_or(0)
+                .max(-200);
+            Row {
+                a: [0, 1, 2].map(|j| scaled(r[j], 30 - e) as i32),
+                t: scaled(r[3], 60 - p - e),
+                e,
+            }
+        });
+        let w = rows[2];
+        // W_near in W's units 2^(p + e - 60), rounded up; beyond 2^62 no W reaches it.
+        let near = ceil_scaled(planes.near(), 60 - p - w.e);
+        Ok(IntTransform { rows, p, near })
+    }
+
+    /// The projected vertex, or `None` where it needs clipping (behind `W_near`, or beyond the clip guard band).
+    /// [`Error::WorldTooLarge`] where `rhw` leaves the f32 range (a `W_near` below about `3e-39`).
+    pub(crate) fn project(&self, q: &[f32; 3]) -> Result<Option<Projected>, Error> {
+        let pq = q.map(|v| to_31(v, 30 - self.p));
+        let value = |r: &Row| -> i64 {
+            let mut s = r.t;
+            for j in 0..3 {
+                s = s.wrapping_add(smul(r.a[j], pq[j]));
+            }
+            s
+        };
+        let w = value(&self.rows[2]);
+        if w < self.near || w <= 0 {
+            return Ok(None);
+        }
+        // W = wm 2^(32 - lw) units (wm its top 32 bits), so 1/W = r 2^(lw - 93) per unit, r = 2^61 / wm.
+        let lw = 64 - bits64(w as u64) as i32;
+        let wm = ((w as u64) << lw >> 32) as u32;
+        let r = fresh61::<Chord>(wm) as u32;
+        // rhw = r 2^(lw - 93) / 2^(p + e_w - 60).
+        let ew = self.rows[2].e;
+        let rhw = to_f32(false, r as u64, lw - 33 - self.p - ew);
+        if !(rhw.is_finite() && rhw > 0.0) {
+            return Err(Error::WorldTooLarge);
+        }
+        // x = X' / W: X' = xm 2^(32 - lx) units of 2^(p + e_x - 60); times r 2^(lw - 93) / 2^(p + e_w - 60).
+        let screen = |row: &Row| -> f32 {
+            let v = value(row);
+            if v == 0 {
+                return 0.0;
+            }
+            let mag = v.unsigned_abs();
+            let lx = 64 - bits64(mag) as i32;
+            let xm = (mag << lx >> 32) as u32;
+            to_f32(v < 0, mul_wide(xm, r), lw - lx - 61 + row.e - ew)
+        };
+        let (x, y) = (screen(&self.rows[0]), screen(&self.rows[1]));
+        if !(x.abs() <= CLIP_BAND && y.abs() <= CLIP_BAND) {
+            return Ok(None);
+        }
+        Ok(Some(Projected { x, y, rhw }))
+    }
+}
+
+/// `ceil(v 2^s)` for a positive finite `v`, saturated at `i64::MAX` from `2^62` on (no `W` reaches that).
+fn ceil_scaled(v: f32, s: i32) -> i64 {
+    let Some((_, m, e)) = split(v) else {
+        return i64::MAX;
+    };
+    if m == 0 {
+        return 0;
+    }
+    let sh = e + s;
+    if sh >= 0 {
+        if sh + (32 - m.leading_zeros() as i32) > 62 {
+            i64::MAX
+        } else {
+            (m as i64) << sh
+        }
+    } else if sh > -40 {
+        let k = (-sh) as u32;
+        ((m as u64 + (1u64 << k) - 1) >> k) as i64
+    } else {
+        1
+    }
+}
+
+/// `round(v 2^s)` for a finite coordinate below `2^(30 - s)`... in magnitude: at most 31 bits, in 32-bit arithmetic
+/// (the mantissa has 24 bits and its shift is below 7 to the left, or to the right with rounding to nearest, ties up).
+#[inline]
+fn to_31(v: f32, s: i32) -> i32 {
+    let Some((neg, m, e)) = split(v) else {
+        return 0;
+    };
+    let sh = e + s;
+    let r = if sh >= 0 {
+        m << sh.min(7)
+    } else if sh > -32 {
+        let k = (-sh) as u32;
+        (m >> k) + ((m >> (k - 1)) & 1)
+    } else {
+        0
+    };
+    if neg {
+        -(r as i32)
+    } else {
+        r as i32
+    }
+}
+
+/// `a b` exactly, as `i64`: the unsigned product of the magnitudes by [`mul_wide`] (four `MULS` on the Cortex-M0,
+/// where a 64-bit multiply is a library call), then the sign.
+#[inline]
+fn smul(a: i32, b: i32) -> i64 {
+    let m = mul_wide(a.unsigned_abs(), b.unsigned_abs()) as i64;
+    if (a < 0) != (b < 0) {
+        -m
+    } else {
+        m
+    }
+}
+
+/// `(-1)^neg m 2^s` rounded to the nearest f32 (ties to even), subnormals included, infinity above the range; `m > 0`.
+fn to_f32(neg: bool, m: u64, s: i32) -> f32 {
+    let b = bits64(m) as i32;
+    // Value = m 2^s, with its leading bit at 2^(b - 1 + s): the f32 exponent.
+    let exp = b - 1 + s;
+    if exp > 127 {
+        return if neg { -f32::INFINITY } else { f32::INFINITY };
+    }
+    // Keep 24 bits (fewer for a subnormal: its last bit is 2^-149).
+    let keep = if exp < -126 { 24 - (-126 - exp) } else { 24 };
+    let drop = b - keep;
+    let mant = if drop > 64 {
+        0
+    } else if drop == 64 {
+        u64::from(m > 1 << 63)
+    } else if drop > 0 {
+        let q = m >> drop;
+        let rem = m & ((1u64 << drop) - 1);
+        let half = 1u64 << (drop - 1);
+        q + u64::from(rem > half || (rem == half && q & 1 == 1))
+    } else {
+        m << (-drop)
+    };
+    // mant below 2^24 (or 2^keep); a rounding carry to 2^24 moves the exponent: from_bits' addition handles it.
+    let bits = if exp < -126 {
+        mant as u32
+    } else {
+        (((exp + 126) as u32) << 23) + mant as u32
+    };
+    let v = f32::from_bits(bits);
+    if neg {
+        -v
+    } else {
+        v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::clip::Viewport;
+
+    fn rnd(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
+    /// `to_f32` is the correctly rounded conversion (the host's f64 -> f32 cast of the exact value, which is exact in
+    /// f64 for `m < 2^53`), for random mantissas and exponents across the normal and subnormal range.
+    #[test]
+    fn to_f32_rounds_to_nearest_even() {
+        let mut s = 0x1234_5678_9ABC_DEF1u64;
+        for _ in 0..200_000 {
+            let m = rnd(&mut s) >> (11 + rnd(&mut s) % 40);
+            if m == 0 {
+                continue;
+            }
+            let e = (rnd(&mut s) % 300) as i32 - 200;
+            let exact = m as f64 * 2f64.powi(e);
+            assert_eq!(to_f32(false, m, e), exact as f32, "{m} 2^{e}");
+            assert_eq!(to_f32(true, m, e), -(exact as f32), "{m} 2^{e}");
+        }
+        // Ties: 2^24 + 1 rounds down to even, 2^24 + 3 up.
+        assert_eq!(to_f32(false, (1 << 25) + 1, -1), 16_777_216.0);
+        assert_eq!(to_f32(false, (1 << 25) + 3, -1), 16_777_218.0);
+    }
+
+    /// `to_31` equals the exact rounding (ties up) of `v 2^s` for coordinates below `2^(30 - s)`.
+    #[test]
+    fn to_31_rounds_to_nearest() {
+        let mut st = 0x0BAD_5EED_0000_0001u64;
+        for _ in 0..200_000 {
+            let p = (rnd(&mut st) % 40) as i32 - 20;
+            let v = ((rnd(&mut st) >> 11) as f64 / 2f64.powi(53) * 2.0 - 1.0) as f32 * 2f32.powi(p);
+            let s = 30 - p;
+            let exact = (v as f64 * 2f64.powi(s)).abs();
+            let want = (exact + 0.5).floor() as i64 * if v < 0.0 { -1 } else { 1 };
+            assert_eq!(to_31(v, s) as i64, want, "{v} {s}");
+        }
+    }
+
+    /// Projected vertices against f64 arithmetic on the same f32 positions and matrix, for random rotations, scales
+    /// from `2^-10` to `2^10`, distances and a W-friendly perspective, within the module doc's derived bounds:
+    /// `x` (and `y`) within `2^-22.3 M + 2^-23.9 |x|` px, where `M` is the sum of the magnitudes of the folded row's
+    /// terms over `W` (in pixels; the fold's f32 roundings scale with it), and `rhw` within `2^-23.9 + 2^-29 M_w`
+    /// relative (`M_w` the same for `W`). And the same vertices marked for clipping as the exact test says, away from
+    /// its boundaries by more than the bound.
+    #[test]
+    fn projection_is_within_its_bound() {
+        use crate::projection::Mat4;
+        use std::vec::Vec;
+        let vp = Viewport::new(0.0, 0.0, 320.0, 240.0);
+        let planes = Planes::new(0.5, &vp).unwrap();
+        let (sx, sy, ox, oy) = planes.map_constants();
+        let (sx, sy, ox, oy) = (sx as f64, sy as f64, ox as f64, oy as f64);
+        let mut st = 0xFEED_0000_1111_2222u64;
+        let mut unit = move || (rnd(&mut st) >> 11) as f32 / (1u64 << 53) as f32;
+        let (mut worst_xy, mut worst_rhw, mut drawn) = (0.0f64, 0.0f64, 0);
+        for _ in 0..400 {
+            let scale = 2f32.powi((unit() * 20.0) as i32 - 10);
+            let (a, b) = (unit() * 6.3, unit() * 6.3);
+            let (ca, sa, cb, sb) = (
+                micromath::F32(a).cos().0,
+                micromath::F32(a).sin().0,
+                micromath::F32(b).cos().0,
+                micromath::F32(b).sin().0,
+            );
+            let dist = scale * (2.0 + unit() * 8.0);
+            let f = 1.7f32;
+            let m = Mat4([
+                [ca * f, sa * sb * f * 0.75, -sa * cb, -sa * cb],
+                [0.0, cb * f * 0.75, sb, sb],
+                [sa * f, -ca * sb * f * 0.75, ca * cb, ca * cb],
+                [0.0, 0.0, dist, dist],
+            ]);
+            let pos: Vec<[f32; 3]> = (0..64)
+                .map(|_| [0, 1, 2].map(|_| (unit() * 2.0 - 1.0) * scale))
+                .collect();
+            let it = IntTransform::new(&m, &planes, &pos).unwrap();
+            for q in &pos {
+                let qq = [q[0] as f64, q[1] as f64, q[2] as f64, 1.0];
+                let col = |i: usize| -> [f64; 4] { core::array::from_fn(|j| m.0[j][i] as f64) };
+                let (cx, cy, cw) = (col(0), col(1), col(3));
+                let dot = |r: [f64; 4]| (0..4).map(|j| r[j] * qq[j]).sum::<f64>();
+                let mag = |r: [f64; 4]| (0..4).map(|j| (r[j] * qq[j]).abs()).sum::<f64>();
+                let w = dot(cw);
+                let (xe, ye) = (ox + sx * dot(cx) / w, oy - sy * dot(cy) / w);
+                let fx: [f64; 4] =
+                    core::array::from_fn(|j| (sx * cx[j]).abs() + (ox * cw[j]).abs());
+                let fy: [f64; 4] =
+                    core::array::from_fn(|j| (sy * cy[j]).abs() + (oy * cw[j]).abs());
+                let (mx, my, mw) = (mag(fx) / w.abs(), mag(fy) / w.abs(), mag(cw) / w.abs());
+                let inside = w >= 0.5 && xe.abs() <= 4000.0 && ye.abs() <= 4000.0;
+                let near_edge = (w - 0.5).abs() < 1e-6 * w.abs()
+                    || (xe.abs() - 4000.0).abs() < 1e-2 * (1.0 + mx)
+                    || (ye.abs() - 4000.0).abs() < 1e-2 * (1.0 + my);
+                match it.project(q).unwrap() {
+                    Some(p) => {
+                        assert!(inside || near_edge, "{q:?} drawn, exact outside");
+                        let bx = 2f64.powf(-22.3) * mx + 2f64.powf(-23.9) * xe.abs();
+                        let by = 2f64.powf(-22.3) * my + 2f64.powf(-23.9) * ye.abs();
+                        let (dx, dy) = ((p.x as f64 - xe).abs(), (p.y as f64 - ye).abs());
+                        worst_xy = worst_xy.max(dx / bx).max(dy / by);
+                        assert!(dx <= bx && dy <= by, "{q:?}: {} {} vs {xe} {ye}", p.x, p.y);
+                        let rel = (p.rhw as f64 * w - 1.0).abs();
+                        let br = 2f64.powf(-23.9) + 2f64.powi(-29) * mw;
+                        worst_rhw = worst_rhw.max(rel / br);
+                        assert!(rel <= br, "{q:?}: rhw {rel:e}");
+                        drawn += 1;
+                    }
+                    None => assert!(!inside || near_edge, "{q:?} marked, exact inside"),
+                }
+            }
+        }
+        std::println!(
+            "integer transform: {drawn} vertices, worst x/y {worst_xy:.3} of the bound, rhw {worst_rhw:.3}"
+        );
+        assert!(drawn > 10_000, "{drawn}");
+    }
+}
