@@ -119,11 +119,9 @@ impl IntTransform {
     pub(crate) fn project(&self, q: &[f32; 3]) -> Result<Option<Projected>, Error> {
         let pq = q.map(|v| to_31(v, 30 - self.p));
         let value = |r: &Row| -> i64 {
-            let mut s = r.t;
-            for j in 0..3 {
-                s = s.wrapping_add(smul(r.a[j], pq[j]));
-            }
-            s
+            r.a.iter()
+                .zip(pq)
+                .fold(r.t, |s, (&a, p)| s.wrapping_add(smul(a, p)))
         };
         let w = value(&self.rows[2]);
         if w < self.near || w <= 0 {
