@@ -24,7 +24,7 @@
 //! (`host-tests/tests/mesh.rs`) allow for.
 
 use crate::clip::{Planes, CLIP_BAND};
-use crate::fast::{bits64, fresh61, mul_wide, Chord};
+use crate::fast::{bits64, fresh61, mul_wide, Chord, NO_CLZ};
 use crate::fixed::{round_shift, split};
 use crate::mesh::Projected;
 use crate::projection::Mat4;
@@ -128,12 +128,11 @@ impl IntTransform {
             return Ok(None);
         }
         // W = wm 2^(32 - lw) units (wm its top 32 bits), so 1/W = r 2^(lw - 93) per unit, r = 2^61 / wm.
-        let lw = 64 - bits64(w as u64) as i32;
-        let wm = ((w as u64) << lw >> 32) as u32;
+        let (wm, lw) = top32(w as u64);
         let r = fresh61::<Chord>(wm) as u32;
         // rhw = r 2^(lw - 93) / 2^(p + e_w - 60).
         let ew = self.rows[2].e;
-        let rhw = to_f32(false, r as u64, lw - 33 - self.p - ew);
+        let rhw = f32_of(false, r, false, lw - 33 - self.p - ew);
         if !(rhw.is_finite() && rhw > 0.0) {
             return Err(Error::WorldTooLarge);
         }
@@ -143,10 +142,14 @@ impl IntTransform {
             if v == 0 {
                 return 0.0;
             }
-            let mag = v.unsigned_abs();
-            let lx = 64 - bits64(mag) as i32;
-            let xm = (mag << lx >> 32) as u32;
-            to_f32(v < 0, mul_wide(xm, r), lw - lx - 61 + row.e - ew)
+            let (xm, lx) = top32(v.unsigned_abs());
+            let p = mul_wide(xm, r);
+            f32_of(
+                v < 0,
+                (p >> 32) as u32,
+                p as u32 != 0,
+                lw - lx - 29 + row.e - ew,
+            )
         };
         let (x, y) = (screen(&self.rows[0]), screen(&self.rows[1]));
         if !(x.abs() <= CLIP_BAND && y.abs() <= CLIP_BAND) {
@@ -211,6 +214,76 @@ fn smul(a: i32, b: i32) -> i64 {
         -m
     } else {
         m
+    }
+}
+
+/// The leading zeros of `v != 0`: `CLZ` where the core has one, else a five-step binary search (on the Cortex-M0 and
+/// RV32IMAC `leading_zeros` is a library call).
+#[inline(always)]
+fn clz32(v: u32) -> u32 {
+    if !NO_CLZ {
+        return v.leading_zeros();
+    }
+    let (mut v, mut n) = (v, 0);
+    if v >> 16 == 0 {
+        n += 16;
+        v <<= 16;
+    }
+    if v >> 24 == 0 {
+        n += 8;
+        v <<= 8;
+    }
+    if v >> 28 == 0 {
+        n += 4;
+        v <<= 4;
+    }
+    if v >> 30 == 0 {
+        n += 2;
+        v <<= 2;
+    }
+    n + u32::from(v >> 31 == 0)
+}
+
+/// The top 32 bits of `v != 0` and its leading zeros `l`: `v` is `m 2^(32 - l)`, truncated (below `2^-31`), with `m`
+/// in `[2^31, 2^32)`. 32-bit shifts only (a variable 64-bit shift is a library call on the 32-bit cores).
+#[inline(always)]
+fn top32(v: u64) -> (u32, i32) {
+    let (hi, lo) = ((v >> 32) as u32, v as u32);
+    if hi != 0 {
+        let l = clz32(hi);
+        let m = if l == 0 {
+            hi
+        } else {
+            (hi << l) | (lo >> (32 - l))
+        };
+        (m, l as i32)
+    } else {
+        let l = clz32(lo);
+        (lo << l, 32 + l as i32)
+    }
+}
+
+/// `(-1)^neg (m + f) 2^s` rounded to the nearest f32 (ties to even), for `m != 0` and a fraction `0 <= f < 1` that
+/// is nonzero exactly when `sticky`, where `m >= 2^25` whenever `sticky` (the rounding position then lies in `m`, and
+/// `f` only breaks a tie): the normal range in 32-bit operations, the rest through [`to_f32`].
+#[inline(always)]
+fn f32_of(neg: bool, m: u32, sticky: bool, s: i32) -> f32 {
+    let l = clz32(m);
+    let exp = 31 - l as i32 + s;
+    if !(-126..=127).contains(&exp) {
+        // Subnormal or infinite: the sticky fraction as one bit below `m`.
+        return to_f32(neg, (m as u64) << 1 | u64::from(sticky), s - 1);
+    }
+    let n = m << l;
+    let (mant, rem) = (n >> 8, n & 0xff);
+    let up = rem > 0x80 || (rem == 0x80 && (sticky || mant & 1 == 1));
+    // The leading bit of `mant` adds one to the exponent field; a rounding carry to 2^24 one more (to infinity
+    // from the top binade, as it should).
+    let v = f32::from_bits((((exp + 126) as u32) << 23) + mant + u32::from(up));
+    if neg {
+        -v
+    } else {
+        v
     }
 }
 
@@ -281,6 +354,33 @@ mod tests {
         // Ties: 2^24 + 1 rounds down to even, 2^24 + 3 up.
         assert_eq!(to_f32(false, (1 << 25) + 1, -1), 16_777_216.0);
         assert_eq!(to_f32(false, (1 << 25) + 3, -1), 16_777_218.0);
+    }
+
+    /// `f32_of` equals `to_f32` of the same value (with the fraction as one bit below `m`), and `top32` the top 32
+    /// bits, for random values and every leading-zero count; `clz32` is `leading_zeros`.
+    #[test]
+    fn f32_of_top32_and_clz32_are_exact() {
+        let mut s = 0x7777_1234_0000_0001u64;
+        for _ in 0..200_000 {
+            let v = rnd(&mut s) >> (rnd(&mut s) % 64);
+            if v == 0 {
+                continue;
+            }
+            let (m, l) = top32(v);
+            assert_eq!(l as u32, v.leading_zeros(), "{v}");
+            assert_eq!(m as u64, (v << l) >> 32, "{v}");
+            assert_eq!(clz32(v as u32 | 1), (v as u32 | 1).leading_zeros());
+            let m = (v >> 32) as u32 | 1;
+            let sticky = v as u32 & 1 == 1 && m >= 1 << 25;
+            let e = (rnd(&mut s) % 320) as i32 - 200;
+            for neg in [false, true] {
+                assert_eq!(
+                    f32_of(neg, m, sticky, e).to_bits(),
+                    to_f32(neg, (m as u64) << 1 | u64::from(sticky), e - 1).to_bits(),
+                    "{m} {sticky} {e}"
+                );
+            }
+        }
     }
 
     /// `to_31` equals the exact rounding (ties up) of `v 2^s` for coordinates below `2^(30 - s)`.
