@@ -10,13 +10,14 @@
 //! Then `x = 2^X / tau` (`X = 61` down, `60` up) lies in `(2^29, 2^30]`, and `c = (x + 2^(s-1)) >> s` with
 //! `s = X + 16 - F - lz` (`lz` the normalising shift): two instructions.
 //!
-//! **The reciprocal.** On a binade where `tau` changes by at most `2^-8` of itself per pixel (*chained*), `x` is
-//! carried from pixel to pixel: the seed `x_k + (x_k - x_(k-1))` (a linear extrapolation, relative error at most
-//! `2 r^2 (1 + 2^-6)` for a relative step `r <= 2^-8`, plus three times the carried error), then one Newton-Raphson
-//! step `x' = x - x (tau x - 1)` in 32-bit products (`UMULL`, `SMMUL`), which squares the seed's error and adds the
-//! products' truncation. Steeper binades take a fresh reciprocal per pixel (a 128-cell piecewise-linear seed and one
-//! step). [`FAST_MAX_REL_ERROR`] is the bound over both, derived below and swept in
-//! the tests; times 65535 it is the largest code error: `2^-11.2` LSB (`65535 * 6.5e-9 = 4.3e-4`).
+//! **The reciprocal.** On a binade where `tau` changes by at most `2^-8` (`FastDiv`) or `2^-9` (`Fast`) of itself per
+//! pixel (*chained*), `x` is carried from pixel to pixel: the seed `x_k + (x_k - x_(k-1))` (a linear extrapolation,
+//! relative error at most `2 r^2 (1 + 2^-6)` for a relative step `r`, plus three times the carried error), then one
+//! Newton-Raphson step `x' = x - x (tau x - 1)`, which squares the seed's error and adds the products' truncation.
+//! Steeper binades take a fresh reciprocal per pixel (a seed and one step). How each strategy seeds and steps is its
+//! [`FreshSeed`]: `Divide` in 32 x 32 -> 64 products (`UMULL`, `SMMUL`), `Chord` in products that fit 32 bits (the
+//! Cortex-M0's `MULS`). [`FAST_MAX_REL_ERROR`] is the bound over all of them, derived below and swept in the tests;
+//! times 65535 it is the largest code error: `2^-11.2` LSB (`65535 * 6.5e-9 = 4.3e-4`).
 //!
 //! **The test before the reciprocal.** With the `Less` comparison, a pixel whose stored code `s` satisfies
 //! `2^G / tau >= s` (`G = X - s`) fails whatever the rounding, since the computed code errs by far less than 1/2.
@@ -32,10 +33,14 @@ use crate::Error;
 
 /// Largest relative error of the fast tier's `x` against the exact `2^X / tau_exact` (`tau_exact` the unrounded
 /// high word of the exact `V`), over both modes:
-/// - fresh: a 128-cell chord seed (`2^-14.8`) and one step: `< 2^-27.6` (see `fresh61`);
-/// - chained: seed error `e_s <= 2 r^2 (1 + 2^-6) + 3 e` with `r <= 2^-8`, so `e_s < 2^-14.9` for any `e <= 2^-20`;
-///   the step gives `e_s^2 + 2^-29` (truncated `tau x` product: one unit of `2^-29` in the residual) `+ 2^-29`
-///   (truncated `SMMUL`) `< 2^-27.6`; the fixed point of `e = (2^-14.9 + 3e)^2 + 2^-28` stays below `2^-27.5`;
+/// - fresh: `< 2^-27.6` (`Divide`: a division seed and a 64-bit step) or `< 2^-27.9` (`Chord`: a 17-bit chord
+///   seed and the half-word step, [`half_step`]);
+/// - chained, `Divide`: seed error `e_s <= 2 r^2 (1 + 2^-6) + 3 e` with `r <= 2^-8`, so `e_s < 2^-14.9` for any
+///   `e <= 2^-20`; the step gives `e_s^2 + 2^-29` (truncated `tau x` product: one unit of `2^-29` in the residual)
+///   `+ 2^-29` (truncated `SMMUL`) `< 2^-27.6`; the fixed point of `e = (2^-14.9 + 3e)^2 + 2^-28` stays below
+///   `2^-27.5`;
+/// - chained, `Chord` (`r <= 2^-9`): the seed rounded to 17 bits errs by less than `2^-15.9` ([`Chord`]), inside
+///   the `2^-15.5` its step allows, which then gives `< 2^-27.9`;
 /// - `tau` itself: the truncated high word is below the exact one by less than one unit of `2^-30` relative.
 ///
 /// Sum: `2^-27.5 + 2^-30 < 2^-27.2`.
