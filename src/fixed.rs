@@ -123,9 +123,138 @@ pub(crate) fn div_u128_shift(n: u128, d: u64) -> u128 {
     lo as u128
 }
 
+/// Exact `floor(n / d)` by one divisor `0 < d < 2^62`, several times (the plane solve divides three numerators by
+/// its area, in every band a triangle reaches): the reciprocal of the normalised divisor is formed once (one
+/// [`div_u128`]), then each quotient below `2^64` takes one 64 x 64 -> 128-bit product, one 64-bit product and at
+/// most two corrections, where [`div_u128_shift`] takes a step per quotient bit (Moller and Granlund, "Improved
+/// Division by Invariant Integers", IEEE Transactions on Computers, 2011, algorithm 4). A larger quotient (an extreme
+/// sliver's step) takes [`div_u128`]. 64-bit hosts divide in hardware (the same exact floor).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Divisor {
+    d: u64,
+    /// `d`'s leading zeros, and `d` shifted by them (top bit set).
+    s: u32,
+    dn: u64,
+    /// `floor((2^128 - 1) / dn) - 2^64`.
+    v: u64,
+}
+
+impl Divisor {
+    pub(crate) fn new(d: u64) -> Divisor {
+        debug_assert!(d > 0 && d < 1 << 62);
+        let s = d.leading_zeros();
+        let dn = d << s;
+        // (2^128 - 1) - 2^64 dn = (2^64 - 1 - dn) 2^64 + (2^64 - 1): its high word `!dn` is below `dn`.
+        let v = div_u128(((!dn as u128) << 64) | u64::MAX as u128, dn) as u64;
+        Divisor { d, s, dn, v }
+    }
+
+    /// `floor(n / d)`.
+    #[inline]
+    pub(crate) fn div(&self, n: u128) -> u128 {
+        if cfg!(target_pointer_width = "64") {
+            n / self.d as u128
+        } else {
+            self.div_preinv(n)
+        }
+    }
+
+    /// `round(n / d)`, ties away from zero, for a signed `n` (`|n| + d/2` below `2^127`).
+    #[inline]
+    pub(crate) fn div_round(&self, n: i128) -> i128 {
+        let q = self.div(n.unsigned_abs() + (self.d / 2) as u128) as i128;
+        if n < 0 {
+            -q
+        } else {
+            q
+        }
+    }
+
+    /// [`Divisor::div`] by the reciprocal (what 32-bit targets run; tested on every host).
+    fn div_preinv(&self, n: u128) -> u128 {
+        if (n >> 64) as u64 >= self.d {
+            return div_u128_shift(n, self.d);
+        }
+        // n < d 2^64, so n 2^s < dn 2^64: the normalised numerator fits, its high word below dn.
+        let nn = n << self.s;
+        let (u1, u0) = ((nn >> 64) as u64, nn as u64);
+        let q = mul_64x64(self.v, u1).wrapping_add(((u1 as u128 + 1) << 64) | u0 as u128);
+        let (mut q1, q0) = ((q >> 64) as u64, q as u64);
+        let mut r = u0.wrapping_sub(q1.wrapping_mul(self.dn));
+        if r > q0 {
+            q1 = q1.wrapping_sub(1);
+            r = r.wrapping_add(self.dn);
+        }
+        if r >= self.dn {
+            q1 += 1;
+        }
+        q1 as u128
+    }
+}
+
+/// The exact 128-bit product of two `u64` from four 32 x 32 -> 64 products (`mul_wide`: four `MULS` each on the
+/// Cortex-M0, `UMULL` on the M4), where a `u128` multiply is a library call on the 32-bit cores.
+#[inline]
+fn mul_64x64(a: u64, b: u64) -> u128 {
+    use crate::fast::mul_wide;
+    let (ah, al, bh, bl) = ((a >> 32) as u32, a as u32, (b >> 32) as u32, b as u32);
+    let ll = mul_wide(al, bl) as u128;
+    let mid = mul_wide(al, bh) as u128 + mul_wide(ah, bl) as u128;
+    let hh = mul_wide(ah, bh) as u128;
+    (hh << 64) + (mid << 32) + ll
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The reciprocal division equals `u128` division for divisors of every size below `2^62` (and both ends of the
+    /// range), numerators with quotients below and above `2^64`, and the edges of each: the reciprocal path taken
+    /// explicitly (the host's own `div` divides in hardware); and `div_round` is the rounded quotient.
+    #[test]
+    fn reciprocal_division_is_exact() {
+        let mut s: u64 = 0x0DDB_A11C_0FFE_E123;
+        let mut rnd = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        let mut fast = 0;
+        for k in 0..300_000 {
+            let d = match k % 50 {
+                0 => 1,
+                1 => (1 << 62) - 1,
+                2 => 1 << (rnd() % 62),
+                _ => ((rnd() >> 2) >> (rnd() % 62)).max(1),
+            };
+            let dv = Divisor::new(d);
+            assert_eq!(
+                dv.v as u128,
+                u128::MAX / ((d << d.leading_zeros()) as u128) - (1u128 << 64),
+                "v of {d}"
+            );
+            let n = ((rnd() as u128) << 64 | rnd() as u128) >> (rnd() % 128);
+            for n in [
+                n,
+                ((d as u128) << 64) - 1,
+                (d as u128) << 64,
+                n % ((d as u128) << 64),
+                (n % ((d as u128) << 64)) / d as u128 * d as u128,
+                ((n % ((d as u128) << 64)) / d as u128 * d as u128).saturating_sub(1),
+            ] {
+                fast += u32::from(n >> 64 < d as u128);
+                assert_eq!(dv.div_preinv(n), n / d as u128, "{n} / {d}");
+            }
+            let m = (rnd() as i128) << 40 >> (rnd() % 60);
+            let r = (m.unsigned_abs() + (d / 2) as u128) / d as u128;
+            assert_eq!(
+                dv.div_round(m),
+                if m < 0 { -(r as i128) } else { r as i128 }
+            );
+        }
+        assert!(fast > 1_000_000, "{fast}");
+    }
 
     /// A mantissa that is not normalised (a 32-bit fixed-point `1/W` with leading zeros) takes a large left shift:
     /// exact up to 2^63, saturating from there. (Found by the fixed-point input's equality with f32: the old limit

@@ -30,7 +30,7 @@ use embedded_graphics_core::primitives::Rectangle;
 use crate::depth::{encode_w16, DepthBuffer, W16_FAR};
 use crate::edge::{Edge, Sub};
 use crate::fast::{Chord, Divide};
-use crate::fixed::{div_u128, round_shift, split};
+use crate::fixed::{div_u128, round_shift, split, Divisor};
 use crate::input::VertexInput;
 #[cfg(feature = "gouraud")]
 use crate::recip::Inv;
@@ -821,10 +821,12 @@ impl Plane {
             u * (g.i_ref - g.dorigin.0 as i64) as i128 + u / 2 - p0.x as i128,
             u * (g.j_ref - g.dorigin.1) as i128 + u / 2 - p0.y as i128,
         );
+        // Three divisions by the area: its reciprocal once (exact quotients, `Divisor`).
+        let dv = Divisor::new(area as u64);
         Plane {
-            row: (v[0] as i128 + div_round(gx * rx + gy * ry, area)) as i64,
-            sx: div_round(gx * u, area) as i64,
-            sy: div_round(gy * u, area) as i64,
+            row: (v[0] as i128 + dv.div_round(gx * rx + gy * ry)) as i64,
+            sx: dv.div_round(gx * u) as i64,
+            sy: dv.div_round(gy * u) as i64,
         }
         .at_row(g)
     }
