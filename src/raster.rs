@@ -793,6 +793,35 @@ pub(crate) fn t_at_snapped(s: &Setup) -> Option<[i64; 3]> {
 /// The fewest fraction bits a sliver's `T` is solved with (see [`depth_plane`]); below, the snapped plane.
 const MIN_FRAC: u32 = 8;
 
+/// `a b` exactly (two 32 x 32 -> 64 products).
+#[inline]
+fn mul_64_32(a: i64, b: i32) -> i128 {
+    use crate::fast::mul_wide;
+    let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
+    let m = ((mul_wide((ua >> 32) as u32, ub) as u128) << 32) + mul_wide(ua as u32, ub) as u128;
+    if (a < 0) != (b < 0) {
+        -(m as i128)
+    } else {
+        m as i128
+    }
+}
+
+/// `a b` exactly for `|a| < 2^96` (three 32 x 32 -> 64 products; the plane's gradients are below `2^94`).
+#[inline]
+fn mul_96_32(a: i128, b: i32) -> i128 {
+    use crate::fast::mul_wide;
+    debug_assert!(a.unsigned_abs() < 1 << 96);
+    let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
+    let m = ((mul_wide((ua >> 64) as u32, ub) as u128) << 64)
+        + ((mul_wide((ua >> 32) as u32, ub) as u128) << 32)
+        + mul_wide(ua as u32, ub) as u128;
+    if (a < 0) != (b < 0) {
+        -(m as i128)
+    } else {
+        m as i128
+    }
+}
+
 /// A quantity linear in screen space: its value at `(i_ref, current row)` and its steps per column and row.
 #[derive(Clone, Copy)]
 pub(crate) struct Plane {
@@ -809,9 +838,11 @@ impl Plane {
     /// `area < 2^63`.
     pub(crate) fn solve(v: [i64; 3], g: &Geom) -> Plane {
         let [p0, p1, p2] = g.dq;
-        let (d1, d2) = (v[1] as i128 - v[0] as i128, v[2] as i128 - v[0] as i128);
-        let mut gx = d1 * (p2.y - p0.y) as i128 - d2 * (p1.y - p0.y) as i128;
-        let mut gy = d2 * (p1.x - p0.x) as i128 - d1 * (p2.x - p0.x) as i128;
+        // |v| < 2^61, so the differences fit i64; the products by 32-bit position differences are exact limb
+        // products (`mul_64_32`), where an i128 multiply is a chain of library calls on the 32-bit cores.
+        let (d1, d2) = (v[1] - v[0], v[2] - v[0]);
+        let mut gx = mul_64_32(d1, p2.y - p0.y) - mul_64_32(d2, p1.y - p0.y);
+        let mut gy = mul_64_32(d2, p1.x - p0.x) - mul_64_32(d1, p2.x - p0.x);
         let mut area = g.darea as i128;
         if area < 0 {
             (gx, gy, area) = (-gx, -gy, -area);
@@ -821,12 +852,18 @@ impl Plane {
             u * (g.i_ref - g.dorigin.0 as i64) as i128 + u / 2 - p0.x as i128,
             u * (g.j_ref - g.dorigin.1) as i128 + u / 2 - p0.y as i128,
         );
+        // The reference offset is below 2^31 units (the grid's choice): three limb products then; any other offset
+        // takes the general i128 product (the same exact value).
+        let num = match (i32::try_from(rx), i32::try_from(ry)) {
+            (Ok(x), Ok(y)) => mul_96_32(gx, x) + mul_96_32(gy, y),
+            _ => gx * rx + gy * ry,
+        };
         // Three divisions by the area: its reciprocal once (exact quotients, `Divisor`).
         let dv = Divisor::new(area as u64);
         Plane {
-            row: (v[0] as i128 + dv.div_round(gx * rx + gy * ry)) as i64,
-            sx: dv.div_round(gx * u) as i64,
-            sy: dv.div_round(gy * u) as i64,
+            row: (v[0] as i128 + dv.div_round(num)) as i64,
+            sx: dv.div_round(gx << g.dbits) as i64,
+            sy: dv.div_round(gy << g.dbits) as i64,
         }
         .at_row(g)
     }
@@ -1273,6 +1310,33 @@ mod tests {
         assert_eq!(div_round(-7, 2), -4);
         assert_eq!(div_round(7, 2), 4);
         assert_eq!(div_round(-5, 3), -2);
+    }
+
+    /// The plane solve's limb products equal the i128 products, at the ends of their ranges and on random values.
+    #[test]
+    fn limb_products_are_exact() {
+        let mut s: u64 = 0x51DE_CA75_0000_0001;
+        let mut rnd = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        let ends64 = [0, 1, -1, i64::MAX, i64::MIN + 1, 1 << 61, -(1 << 61)];
+        let ends32 = [0, 1, -1, i32::MAX, i32::MIN, 1 << 30];
+        for &a in &ends64 {
+            for &b in &ends32 {
+                assert_eq!(mul_64_32(a, b), a as i128 * b as i128, "{a} {b}");
+            }
+        }
+        for _ in 0..200_000 {
+            let a = (rnd() as i64) >> (rnd() % 64);
+            let b = (rnd() as i32) >> (rnd() % 32);
+            assert_eq!(mul_64_32(a, b), a as i128 * b as i128, "{a} {b}");
+            let w = ((rnd() as i128) << 32 | rnd() as i128) >> (rnd() % 96) >> 1; // below 2^95
+            let w = if rnd() % 2 == 0 { w } else { -w };
+            assert_eq!(mul_96_32(w, b), w * b as i128, "{w} {b}");
+        }
     }
 
     /// The depth grid's fraction bits are the finest that keep a box's positions in 31 bits: `(extent + 2) 2^bits`
