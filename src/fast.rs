@@ -310,8 +310,21 @@ fn smul_hi_halves(a: i32, b: i32) -> i32 {
 #[inline(always)]
 fn slope<const UP: bool>(x: i32, delta: i32) -> i32 {
     let shift = if UP { 28 } else { 29 };
-    let r32 = (delta as i64 * x as i64) >> shift;
-    (-(x as i64 * r32) >> 32) as i32
+    // 32-bit products (`smul_hi`, four `MULS` on the M0 rather than `__aeabi_lmul` calls), the same bits as the
+    // 64-bit products wherever the slope is used: a chaining binade, `|delta| <= 2^24` (`CHAIN_DOWN`), so
+    // `|r32| < 2^25`. (On a steeper binade `r32` may not fit and the slope is garbage, unused: a chained binade
+    // after it takes a fresh slope, `walk`.)
+    let p = smul_wide(delta, x);
+    let r32 = (p >> shift) as i32;
+    smul_hi(x, r32)
+        .wrapping_neg()
+        .wrapping_sub(i32::from(x.wrapping_mul(r32) != 0))
+}
+
+/// The exact signed 64-bit product from 32-bit pieces ([`smul_hi`] and one wrapping multiply).
+#[inline(always)]
+fn smul_wide(a: i32, b: i32) -> i64 {
+    ((smul_hi(a, b) as i64) << 32) | (a.wrapping_mul(b) as u32 as i64)
 }
 
 /// Whether a binade whose step is `dv` chains (`r` at most the strategy's bound, [`FreshSeed::CHAIN_DOWN`]; the
@@ -360,7 +373,7 @@ fn span_as<S: FreshSeed, D: DrawTarget, const COARSE: bool>(
 ) -> Result<(), Error> {
     let c = Coarse { seg, x0 };
     // T normalised to [2^62, 2^63), then V = T + T/65535 (error below 4 units of 2^62).
-    let l0 = t0.leading_zeros() as i32 - 1;
+    let l0 = 64 - bits64(t0) as i32 - 1; // `bits64`: no library call on cores without CLZ
     let tn = t0 << l0;
     let dn = dt << l0;
     let (v, dv) = (by_65535(tn), by_65535_signed(dn));
