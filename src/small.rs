@@ -199,6 +199,11 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
         sx = sx.wrapping_add((scan.ex[k] as i64).wrapping_mul(w[k] as i64) as u64);
         sy = sy.wrapping_add((scan.ey[k] as i64).wrapping_mul(w[k] as i64) as u64);
     }
+    // Every covered pixel's `S 2^sh` lies between its values at the smallest and the largest vertex `T'` (a convex
+    // combination): where those two have the same leading zeros, so has every pixel, and the loop takes them once.
+    let tp_min = tp[0].min(tp[1]).min(tp[2]);
+    let lz_of = |t: u64| lz_small(((area2 * t) << sh >> 32) as u32);
+    let lz = lz_of(tp_max);
     let walk = Walk {
         j0,
         j1,
@@ -208,6 +213,7 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
         sy: sy << sh,
         kn,
         s0,
+        lz: (lz_of(tp_min) == lz).then_some(lz),
     };
     if DIV {
         let Some(dda) = Dda::new(&pa, j0, ox, oy) else {
@@ -342,6 +348,8 @@ struct Walk {
     sy: u64,
     kn: u32,
     s0: u32,
+    /// The leading zeros of every covered pixel's `S` where they are the same (see `draw_as`).
+    lz: Option<u32>,
 }
 
 impl Walk {
@@ -350,8 +358,33 @@ impl Walk {
         self,
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
+        runs: R,
+        color: D::Color,
+    ) -> Result<Stats, Error> {
+        match self.lz {
+            // `S` pre-shifted by its leading zeros (exact: the walk is exact modulo 2^64, and every covered pixel's
+            // shifted `S` has its top bit set), so that each pixel's normalised `m` is the high word.
+            Some(lz) => Walk {
+                sr: self.sr << lz,
+                sx: self.sx << lz,
+                sy: self.sy << lz,
+                ..self
+            }
+            .rows_as::<S, D, R, true>(target, depth, runs, color, lz),
+            None => self.rows_as::<S, D, R, false>(target, depth, runs, color, 0),
+        }
+    }
+
+    /// [`Walk::rows`], with the leading zeros of `S` the same at every covered pixel (`SAME_LZ`, `lz0`; `S` walked
+    /// pre-shifted by them) or found per pixel. The same bits either way: only where the work is done differs.
+    #[inline(always)]
+    fn rows_as<S: FreshSeed, D: DrawTarget, R: Runs, const SAME_LZ: bool>(
+        self,
+        target: &mut D,
+        depth: &mut DepthBuffer<'_>,
         mut runs: R,
         color: D::Color,
+        lz0: u32,
     ) -> Result<Stats, Error> {
         let Walk {
             j0,
@@ -362,9 +395,11 @@ impl Walk {
             sy,
             kn,
             s0,
+            lz: _,
         } = self;
         let mut stats = Stats::default();
         let width = depth.width() as i32;
+        let sc0 = s0.wrapping_sub(lz0 + 1);
         for j in j0..=j1 {
             let (lo, hi) = runs.run(ox);
             let (lo, hi) = (lo.max(0), hi.min(width));
@@ -375,15 +410,20 @@ impl Walk {
                 let mut pass = 0u32;
                 for stored in row.iter_mut() {
                     let h = (v >> 32) as u32;
-                    let lz = lz_small(h);
-                    let m = (h << lz) | ((v as u32) >> (32 - lz));
+                    let (m, sc) = if SAME_LZ {
+                        (h, sc0)
+                    } else {
+                        let lz = lz_small(h);
+                        ((h << lz) | ((v as u32) >> (32 - lz)), s0 - lz - 1)
+                    };
                     let hi = mul_hi(kn, fresh61::<S>(m) as u32);
-                    let c = (((hi >> (s0 - lz - 1)) + 1) >> 1) as u16;
-                    let ok = c < *stored;
-                    if ok {
-                        *stored = c;
-                    }
+                    // Below 2^16 (the module doc), compared as u32.
+                    let c = ((hi >> sc) + 1) >> 1;
+                    let ok = c < *stored as u32;
                     pass = (pass << 1) | u32::from(ok);
+                    if ok {
+                        *stored = c as u16;
+                    }
                     v = v.wrapping_add(sx);
                 }
                 let n = (hi - lo) as u32; // at most 32: the box is under 32 px wide
