@@ -321,9 +321,10 @@ fn slope<const UP: bool>(x: i32, delta: i32) -> i32 {
         .wrapping_sub(i32::from(x.wrapping_mul(r32) != 0))
 }
 
-/// The exact signed 64-bit product from 32-bit pieces ([`smul_hi`] and one wrapping multiply).
+/// The exact signed 64-bit product from 32-bit pieces ([`smul_hi`] and one wrapping multiply: no `__aeabi_lmul` call
+/// on the Cortex-M0).
 #[inline(always)]
-fn smul_wide(a: i32, b: i32) -> i64 {
+pub(crate) fn smul_wide(a: i32, b: i32) -> i64 {
     ((smul_hi(a, b) as i64) << 32) | (a.wrapping_mul(b) as u32 as i64)
 }
 
@@ -504,7 +505,7 @@ fn walk<const UP: bool, S: FreshSeed, D: DrawTarget, const COARSE: bool>(
 
 /// Cores without a count-leading-zeros instruction, where `leading_zeros` is a library call: ARMv6-M (Cortex-M0,
 /// which has no 32-bit atomics either) and RV32IMAC (no Zbb).
-pub(crate) const NO_CLZ: bool = cfg!(any(
+const NO_CLZ: bool = cfg!(any(
     all(target_arch = "arm", not(target_has_atomic = "32")),
     target_arch = "riscv32"
 ));

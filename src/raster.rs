@@ -672,7 +672,7 @@ fn depth_plane(
 /// vertices off the snap grid.
 #[inline(never)] // once per triangle: out of line, one copy (flash)
 pub(crate) fn t_at_snapped(s: &Setup) -> Option<[i64; 3]> {
-    use crate::fast::{bits64, fresh61, mul_wide, Chord};
+    use crate::fast::{bits64, fresh61, mul_wide, smul_wide, Chord};
     let (p, q, t) = (s.p, s.q, s.t);
     // `a b` exactly for `|a| < 2^63`, `|b| < 2^31`, as (sign, magnitude): two 32 x 32 -> 64 products.
     #[inline(always)]
@@ -716,15 +716,7 @@ pub(crate) fn t_at_snapped(s: &Setup) -> Option<[i64; 3]> {
     let (e2x, e2y) = (q2.x.wrapping_sub(q0.x), q2.y.wrapping_sub(q0.y));
     // Differences below 2^31: each product below 2^62, the doubled area below 2^63 (products by `mul_wide`: the
     // M0's four `MULS` rather than an `__aeabi_lmul` call).
-    let smul = |a: i32, b: i32| {
-        let m = mul_wide(a.unsigned_abs(), b.unsigned_abs()) as i64;
-        if (a < 0) != (b < 0) {
-            -m
-        } else {
-            m
-        }
-    };
-    let area = smul(e1x, e2y) - smul(e2x, e1y);
+    let area = smul_wide(e1x, e2y) - smul_wide(e2x, e1y);
     if area == 0 {
         return None;
     }

@@ -24,7 +24,7 @@
 //! (`host-tests/tests/mesh.rs`) allow for.
 
 use crate::clip::{Planes, CLIP_BAND};
-use crate::fast::{bits64, fresh61, mul_wide, Chord, NO_CLZ};
+use crate::fast::{bits64, fresh61, mul_wide, smul_wide, Chord};
 use crate::fixed::{round_shift, split};
 use crate::mesh::Projected;
 use crate::projection::Mat4;
@@ -121,7 +121,7 @@ impl IntTransform {
         let value = |r: &Row| -> i64 {
             r.a.iter()
                 .zip(pq)
-                .fold(r.t, |s, (&a, p)| s.wrapping_add(smul(a, p)))
+                .fold(r.t, |s, (&a, p)| s.wrapping_add(smul_wide(a, p)))
         };
         let w = value(&self.rows[2]);
         if w < self.near || w <= 0 {
@@ -205,43 +205,11 @@ fn to_31(v: f32, s: i32) -> i32 {
     }
 }
 
-/// `a b` exactly, as `i64`: the unsigned product of the magnitudes by [`mul_wide`] (four `MULS` on the Cortex-M0,
-/// where a 64-bit multiply is a library call), then the sign.
-#[inline]
-fn smul(a: i32, b: i32) -> i64 {
-    let m = mul_wide(a.unsigned_abs(), b.unsigned_abs()) as i64;
-    if (a < 0) != (b < 0) {
-        -m
-    } else {
-        m
-    }
-}
-
-/// The leading zeros of `v != 0`: `CLZ` where the core has one, else a five-step binary search (on the Cortex-M0 and
-/// RV32IMAC `leading_zeros` is a library call).
+/// The leading zeros of `v != 0`, by [`bits64`] (`CLZ` where the core has one, an inline binary search where
+/// `leading_zeros` is a library call: the Cortex-M0 and RV32IMAC).
 #[inline(always)]
 fn clz32(v: u32) -> u32 {
-    if !NO_CLZ {
-        return v.leading_zeros();
-    }
-    let (mut v, mut n) = (v, 0);
-    if v >> 16 == 0 {
-        n += 16;
-        v <<= 16;
-    }
-    if v >> 24 == 0 {
-        n += 8;
-        v <<= 8;
-    }
-    if v >> 28 == 0 {
-        n += 4;
-        v <<= 4;
-    }
-    if v >> 30 == 0 {
-        n += 2;
-        v <<= 2;
-    }
-    n + u32::from(v >> 31 == 0)
+    64 - bits64(v as u64) - 32
 }
 
 /// The top 32 bits of `v != 0` and its leading zeros `l`: `v` is `m 2^(32 - l)`, truncated (below `2^-31`), with `m`
