@@ -144,9 +144,12 @@ impl Divisor {
         debug_assert!(d > 0 && d < 1 << 62);
         let s = d.leading_zeros();
         let dn = d << s;
-        // (2^128 - 1) - 2^64 dn = (2^64 - 1 - dn) 2^64 + (2^64 - 1): its high word `!dn` is below `dn`.
-        let v = div_u128(((!dn as u128) << 64) | u64::MAX as u128, dn) as u64;
-        Divisor { d, s, dn, v }
+        Divisor {
+            d,
+            s,
+            dn,
+            v: reciprocal(dn),
+        }
     }
 
     /// `floor(n / d)`.
@@ -190,6 +193,26 @@ impl Divisor {
         }
         q1 as u128
     }
+}
+
+/// `floor((2^128 - 1) / dn) - 2^64` for a normalised `dn` (top bit set): the quotient of `(2^64 - 1 - dn) 2^64 +
+/// (2^64 - 1)` by `dn`, whose high word `!dn` is below `dn`, so it has 64 bits. Shift and subtract with the
+/// remainder's carry bit kept (the remainder reaches `2^65` before a subtraction: [`div_u128_shift`] assumes a
+/// divisor below `2^62` and would lose it). The same code on every target, so that the host's tests check what the
+/// boards run.
+fn reciprocal(dn: u64) -> u64 {
+    debug_assert!(dn >> 63 == 1);
+    let (mut r, mut q) = (!dn, u64::MAX);
+    for _ in 0..64 {
+        let carry = r >> 63;
+        r = (r << 1) | (q >> 63);
+        q <<= 1;
+        if carry != 0 || r >= dn {
+            r = r.wrapping_sub(dn);
+            q |= 1;
+        }
+    }
+    q
 }
 
 /// The exact 128-bit product of two `u64` from four 32 x 32 -> 64 products (`mul_wide`: four `MULS` each on the
