@@ -236,13 +236,7 @@ mod tests {
     /// explicitly (the host's own `div` divides in hardware); and `div_round` is the rounded quotient.
     #[test]
     fn reciprocal_division_is_exact() {
-        let mut s: u64 = 0x0DDB_A11C_0FFE_E123;
-        let mut rnd = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
+        let mut rnd = crate::xorshift(0x0DDB_A11C_0FFE_E123);
         let mut fast = 0;
         for k in 0..300_000 {
             let d = match k % 50 {

@@ -135,6 +135,18 @@ mod small;
 mod state;
 mod transform;
 
+/// A xorshift64 generator for the unit tests. The closure is `Copy`: a copy goes on from the same state, so a view
+/// made from a copy repeats the sequence rather than sharing it.
+#[cfg(test)]
+pub(crate) fn xorshift(mut s: u64) -> impl FnMut() -> u64 + Copy {
+    move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        s
+    }
+}
+
 #[cfg(feature = "coarse")]
 pub use depth::bound_len;
 pub use depth::{DepthBuffer, DepthStore, W16_FAR};

@@ -1307,13 +1307,7 @@ mod tests {
     /// The plane solve's limb products equal the i128 products, at the ends of their ranges and on random values.
     #[test]
     fn limb_products_are_exact() {
-        let mut s: u64 = 0x51DE_CA75_0000_0001;
-        let mut rnd = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
+        let mut rnd = crate::xorshift(0x51DE_CA75_0000_0001);
         let ends64 = [0, 1, -1, i64::MAX, i64::MIN + 1, 1 << 61, -(1 << 61)];
         let ends32 = [0, 1, -1, i32::MAX, i32::MIN, 1 << 30];
         for &a in &ends64 {
@@ -1326,7 +1320,7 @@ mod tests {
             let b = (rnd() as i32) >> (rnd() % 32);
             assert_eq!(mul_64_32(a, b), a as i128 * b as i128, "{a} {b}");
             let w = ((rnd() as i128) << 32 | rnd() as i128) >> (rnd() % 96) >> 1; // below 2^95
-            let w = if rnd() % 2 == 0 { w } else { -w };
+            let w = if rnd().is_multiple_of(2) { w } else { -w };
             assert_eq!(mul_96_32(w, b), w * b as i128, "{w} {b}");
         }
     }

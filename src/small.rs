@@ -494,16 +494,7 @@ mod tests {
     use std::vec;
     use std::vec::Vec;
 
-    /// A xorshift64 generator. The closure is `Copy`: a copy goes on from the same state, so a view such as
-    /// `unit` below, made from a copy, repeats the sequence rather than sharing it.
-    fn xorshift(mut s: u64) -> impl FnMut() -> u64 + Copy {
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        }
-    }
+    use crate::xorshift;
 
     /// A frame 64 pixels wide of `BinaryColor` pixels (0 unwritten), recording every pixel written.
     struct Frame(Vec<u8>);

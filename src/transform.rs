@@ -297,24 +297,17 @@ mod tests {
     use super::*;
     use crate::clip::Viewport;
 
-    fn rnd(state: &mut u64) -> u64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    }
-
     /// `to_f32` is the correctly rounded conversion (the host's f64 -> f32 cast of the exact value, which is exact in
     /// f64 for `m < 2^53`), for random mantissas and exponents across the normal and subnormal range.
     #[test]
     fn to_f32_rounds_to_nearest_even() {
-        let mut s = 0x1234_5678_9ABC_DEF1u64;
+        let mut rnd = crate::xorshift(0x1234_5678_9ABC_DEF1);
         for _ in 0..200_000 {
-            let m = rnd(&mut s) >> (11 + rnd(&mut s) % 40);
+            let m = rnd() >> (11 + rnd() % 40);
             if m == 0 {
                 continue;
             }
-            let e = (rnd(&mut s) % 300) as i32 - 200;
+            let e = (rnd() % 300) as i32 - 200;
             let exact = m as f64 * 2f64.powi(e);
             assert_eq!(to_f32(false, m, e), exact as f32, "{m} 2^{e}");
             assert_eq!(to_f32(true, m, e), -(exact as f32), "{m} 2^{e}");
@@ -328,9 +321,9 @@ mod tests {
     /// bits, for random values and every leading-zero count; `clz32` is `leading_zeros`.
     #[test]
     fn f32_of_top32_and_clz32_are_exact() {
-        let mut s = 0x7777_1234_0000_0001u64;
+        let mut rnd = crate::xorshift(0x7777_1234_0000_0001);
         for _ in 0..200_000 {
-            let v = rnd(&mut s) >> (rnd(&mut s) % 64);
+            let v = rnd() >> (rnd() % 64);
             if v == 0 {
                 continue;
             }
@@ -340,7 +333,7 @@ mod tests {
             assert_eq!(clz32(v as u32 | 1), (v as u32 | 1).leading_zeros());
             let m = (v >> 32) as u32 | 1;
             let sticky = v as u32 & 1 == 1 && m >= 1 << 25;
-            let e = (rnd(&mut s) % 320) as i32 - 200;
+            let e = (rnd() % 320) as i32 - 200;
             for neg in [false, true] {
                 assert_eq!(
                     f32_of(neg, m, sticky, e).to_bits(),
@@ -354,10 +347,10 @@ mod tests {
     /// `to_31` equals the exact rounding (ties up) of `v 2^s` for coordinates below `2^(30 - s)`.
     #[test]
     fn to_31_rounds_to_nearest() {
-        let mut st = 0x0BAD_5EED_0000_0001u64;
+        let mut rnd = crate::xorshift(0x0BAD_5EED_0000_0001);
         for _ in 0..200_000 {
-            let p = (rnd(&mut st) % 40) as i32 - 20;
-            let v = ((rnd(&mut st) >> 11) as f64 / 2f64.powi(53) * 2.0 - 1.0) as f32 * 2f32.powi(p);
+            let p = (rnd() % 40) as i32 - 20;
+            let v = ((rnd() >> 11) as f64 / 2f64.powi(53) * 2.0 - 1.0) as f32 * 2f32.powi(p);
             let s = 30 - p;
             let exact = (v as f64 * 2f64.powi(s)).abs();
             let want = (exact + 0.5).floor() as i64 * if v < 0.0 { -1 } else { 1 };
@@ -379,8 +372,8 @@ mod tests {
         let planes = Planes::new(0.5, &vp).unwrap();
         let (sx, sy, ox, oy) = planes.map_constants();
         let (sx, sy, ox, oy) = (sx as f64, sy as f64, ox as f64, oy as f64);
-        let mut st = 0xFEED_0000_1111_2222u64;
-        let mut unit = move || (rnd(&mut st) >> 11) as f32 / (1u64 << 53) as f32;
+        let mut rnd = crate::xorshift(0xFEED_0000_1111_2222);
+        let mut unit = move || (rnd() >> 11) as f32 / (1u64 << 53) as f32;
         let (mut worst_xy, mut worst_rhw, mut drawn) = (0.0f64, 0.0f64, 0);
         for _ in 0..400 {
             let scale = 2f32.powi((unit() * 20.0) as i32 - 10);
