@@ -48,6 +48,46 @@ fn snap(v: f32) -> Result<i32, Error> {
     snap_exact(v).map(|(r, _)| r)
 }
 
+/// Whether this core rounds f32 in hardware (the Cortex-M4F's FPU; the hosts' SSE or NEON): [`snap_exact`] then
+/// rounds with two additions instead of integer operations on the bits. The same results either way (both are
+/// round-to-nearest-even of the same exact product; a unit test compares them), so frames stay bit-identical across
+/// cores. An ARM target with the hard-float ABI has an FPU; the Cortex-M0 and RV32IMAC have none.
+const HARD_FLOAT: bool = cfg!(any(
+    target_abi = "eabihf",
+    target_arch = "x86_64",
+    target_arch = "aarch64",
+    all(target_arch = "riscv32", target_feature = "f")
+));
+
+/// `round(v * 256)`, ties to even, and whether it was exact, as [`snap_bits`] (its range checks and results), rounded
+/// by the FPU where the core has one ([`HARD_FLOAT`]): `v * 256` is exact (a power-of-two scale of `|v| < 2^12`), and
+/// for `|s| < 2^22` the sum `s + 1.5 2^23` lies in `[2^23, 2^24)`, where the f32 spacing is 1, so IEEE 754's default
+/// rounding of that sum rounds `s` to the nearest integer, ties to even; subtracting `1.5 2^23` again is exact. On the
+/// Cortex-M4F that is six FPU instructions and one conversion, against some 35 integer ones.
+#[inline]
+fn snap_exact(v: f32) -> Result<(i32, bool), Error> {
+    if !HARD_FLOAT {
+        return snap_bits(v);
+    }
+    let mag = v.to_bits() & 0x7fff_ffff;
+    if mag >= 0x7f80_0000 {
+        return Err(Error::NonFinite);
+    }
+    if mag >= 0x4580_0000 {
+        return Err(Error::OutOfGuardBand);
+    }
+    Ok(snap_fpu(v))
+}
+
+/// [`snap_exact`]'s FPU rounding, for a finite `|v| < 2^12`.
+#[inline(always)]
+fn snap_fpu(v: f32) -> (i32, bool) {
+    const ROUND: f32 = 12_582_912.0; // 1.5 2^23
+    let s = v * 256.0;
+    let r = (s + ROUND) - ROUND;
+    (r as i32, r == s)
+}
+
 // Out of line: one copy instead of one per coordinate (flash), for a few instructions per vertex.
 /// `round(v * 256)`, ties to even, for `|v| < GUARD_BAND = 2^12` (else `OutOfGuardBand`; NaN and infinities
 /// `NonFinite`), in 32-bit integer operations on the bits: `|v| < 2^12` means a biased exponent of at most 138, so
@@ -56,7 +96,7 @@ fn snap(v: f32) -> Result<i32, Error> {
 /// `fixed::to_fixed(v, 8, 12)` (tested on every bit pattern class in the unit tests).
 /// Also says whether the snap was exact (`v` on the 1/256 grid: no remainder), which costs one mask.
 #[inline(never)]
-fn snap_exact(v: f32) -> Result<(i32, bool), Error> {
+fn snap_bits(v: f32) -> Result<(i32, bool), Error> {
     const _: () = assert!(GUARD_BAND == 1 << 12 && SUBPIXEL_BITS == 8);
     let bits = v.to_bits();
     let mag = bits & 0x7fff_ffff;
@@ -296,6 +336,25 @@ mod tests {
             f32::NEG_INFINITY,
         ] {
             check(v);
+        }
+    }
+
+    /// The FPU's rounding ([`snap_exact`] on this host) and the integer one on the bits ([`snap_bits`], the cores
+    /// without an FPU) agree on the value, the exactness flag and the error, on every bit class, every tie of the
+    /// snap grid and its neighbours, and a stride through every f32 bit pattern: the frames are the same on every core.
+    #[test]
+    fn fpu_and_integer_snaps_agree() {
+        assert!(HARD_FLOAT, "the host takes the FPU path");
+        let check = |v: f32| assert_eq!(snap_exact(v), snap_bits(v), "{v:e} ({:#x})", v.to_bits());
+        each_bit_class(1_000_000, 0x7CC1_B727, check);
+        for k in -(1i32 << 21)..(1 << 21) {
+            let t = k as f32 / 512.0; // every half sub-pixel below 2^12: the ties, then their neighbours
+            check(t);
+            check(f32::from_bits(t.to_bits() + 1));
+            check(f32::from_bits(t.to_bits().wrapping_sub(1)));
+        }
+        for b in (0..=u32::MAX).step_by(4099) {
+            check(f32::from_bits(b));
         }
     }
 
