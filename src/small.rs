@@ -219,7 +219,13 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
         let Some(dda) = Dda::new(&pa, j0, ox, oy) else {
             return Ok(None);
         };
-        walk.rows::<S, D, _>(target, depth, dda, color).map(Some)
+        // The third edge's side as a constant of the row loop (one copy each): no per-row choice between the bounds.
+        if dda.x_left {
+            walk.rows::<S, D, _>(target, depth, Sided::<true>(dda), color)
+        } else {
+            walk.rows::<S, D, _>(target, depth, Sided::<false>(dda), color)
+        }
+        .map(Some)
     } else {
         walk.rows::<S, D, _>(target, depth, scan, color).map(Some)
     }
@@ -286,20 +292,24 @@ impl Dda {
     }
 }
 
-impl Runs for Dda {
+/// A [`Dda`] whose third edge bounds the left side (`X_LEFT`) or the right one.
+struct Sided<const X_LEFT: bool>(Dda);
+
+impl<const X_LEFT: bool> Runs for Sided<X_LEFT> {
     #[inline(always)]
     fn run(&self, _: i32) -> (i32, i32) {
-        if self.x_left {
-            (self.l.b.max(self.x.b), self.r.b)
+        let d = &self.0;
+        if X_LEFT {
+            (d.l.b.max(d.x.b), d.r.b)
         } else {
-            (self.l.b, self.r.b.min(self.x.b))
+            (d.l.b, d.r.b.min(d.x.b))
         }
     }
     #[inline(always)]
     fn step(&mut self) {
-        self.l.step();
-        self.r.step();
-        self.x.step();
+        self.0.l.step();
+        self.0.r.step();
+        self.0.x.step();
     }
 }
 
