@@ -146,37 +146,36 @@ impl Edge {
     }
 }
 
-/// One edge's column bound on the current row, walked row by row as [`Edge`] walks `q`: `b = -q` for a left edge (the
-/// first column it admits), `b = q + 1` for a right edge (one past the last), so that a step is `b += sb`, and
-/// `b += inc` on a carry of the remainder. The small triangles' row loop (`crate::small`) keeps three of these in
-/// fixed slots instead of matching on [`Side`] per row.
+/// One edge's column bound on the current row, walked row by row as [`Edge`] walks `q`: `b = q` for a left edge (the
+/// first column it admits is `-b`), `b = q + 1` for a right edge (one past the last), so that both step alike,
+/// `b += sb`, and `b += 1` on a carry of the remainder (no per-edge increment to keep: one register fewer per edge in
+/// the row loop). The small triangles' row loop (`crate::small`) keeps three of these in fixed slots instead of
+/// matching on [`Side`] per row.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Bound {
-    pub b: i32,
+    b: i32,
     r: i32,
     d: i32,
     sb: i32,
     sr: i32,
-    inc: i32,
 }
 
 impl Bound {
-    /// A bound that never binds and never moves: a lower bound for a horizontal edge's slot.
+    /// A bound that never binds and never moves: a left (lower) bound for a horizontal edge's slot.
     pub const NONE: Bound = Bound {
-        b: i32::MIN / 2,
+        b: i32::MAX / 2,
         r: 0,
         d: 1,
         sb: 0,
         sr: 0,
-        inc: 0,
     };
 
     /// The edge's bound and side ([`Bound::NONE`] for a horizontal edge).
     #[inline(always)]
     pub fn of(e: &Edge) -> (Side, Bound) {
-        let (b, sb, inc) = match e.side {
-            Side::Left => (-e.q, -e.step_q, -1),
-            Side::Right => (e.q + 1, e.step_q, 1),
+        let b = match e.side {
+            Side::Left => e.q,
+            Side::Right => e.q + 1,
             Side::Flat => return (Side::Flat, Bound::NONE),
         };
         (
@@ -185,11 +184,28 @@ impl Bound {
                 b,
                 r: e.r,
                 d: e.d,
-                sb,
+                sb: e.step_q,
                 sr: e.step_r,
-                inc,
             },
         )
+    }
+
+    /// A left edge's first admitted column on the current row (`-q`).
+    #[inline(always)]
+    pub fn lo(&self) -> i32 {
+        -self.b
+    }
+
+    /// A right edge's column one past its last admitted one on the current row (`q + 1`).
+    #[inline(always)]
+    pub fn hi(&self) -> i32 {
+        self.b
+    }
+
+    /// Of two left edges' bounds, the larger first column (`-max(-a, -b) = min(a, b)`): one `min` and one negation.
+    #[inline(always)]
+    pub fn lo2(&self, o: &Bound) -> i32 {
+        -self.b.min(o.b)
     }
 
     /// Moves to the next row (the walk of [`Edge::step`]).
@@ -199,7 +215,7 @@ impl Bound {
         self.r += self.sr;
         if self.r >= self.d {
             self.r -= self.d;
-            self.b += self.inc;
+            self.b += 1;
         }
     }
 }

@@ -300,9 +300,9 @@ impl<const X_LEFT: bool> Runs for Sided<X_LEFT> {
     fn run(&self, _: i32) -> (i32, i32) {
         let d = &self.0;
         if X_LEFT {
-            (d.l.b.max(d.x.b), d.r.b)
+            (d.l.lo2(&d.x), d.r.hi())
         } else {
-            (d.l.b, d.r.b.min(d.x.b))
+            (d.l.lo(), d.r.hi().min(d.x.hi()))
         }
     }
     #[inline(always)]
