@@ -215,7 +215,7 @@ fn clz32(v: u32) -> u32 {
 /// The top 32 bits of `v != 0` and its leading zeros `l`: `v` is `m 2^(32 - l)`, truncated (below `2^-31`), with `m`
 /// in `[2^31, 2^32)`. 32-bit shifts only (a variable 64-bit shift is a library call on the 32-bit cores).
 #[inline(always)]
-fn top32(v: u64) -> (u32, i32) {
+pub(crate) fn top32(v: u64) -> (u32, i32) {
     let (hi, lo) = ((v >> 32) as u32, v as u32);
     if hi != 0 {
         let l = clz32(hi);
