@@ -344,7 +344,7 @@ mod tests {
     /// snap grid and its neighbours, and a stride through every f32 bit pattern: the frames are the same on every core.
     #[test]
     fn fpu_and_integer_snaps_agree() {
-        assert!(HARD_FLOAT, "the host takes the FPU path");
+        const { assert!(HARD_FLOAT, "the host takes the FPU path") };
         let check = |v: f32| assert_eq!(snap_exact(v), snap_bits(v), "{v:e} ({:#x})", v.to_bits());
         each_bit_class(1_000_000, 0x7CC1_B727, check);
         for k in -(1i32 << 21)..(1 << 21) {
