@@ -139,6 +139,11 @@ impl<'a> DepthBuffer<'a> {
         }
         Some(self.data[r as usize * self.width as usize + x as usize])
     }
+    /// The stored codes, row-major, to write.
+    #[inline]
+    pub(crate) fn data_mut(&mut self) -> &mut [u16] {
+        self.data
+    }
     #[inline]
     pub(crate) fn row_mut(&mut self, y: i32) -> &mut [u16] {
         let r = (y - self.y0) as usize * self.width as usize;
