@@ -123,18 +123,6 @@ pub(crate) struct Setup<const N: usize = 3> {
     pub(crate) frac: u32,
 }
 
-/// `rhw * W_far` as an exact product of mantissas, `(m, e)` with the value `m * 2^e`.
-#[inline(never)]
-fn t_of(rhw: (u32, i32), far: (u32, i32)) -> Result<(u64, i32), Error> {
-    let (m, e) = rhw;
-    let pm = crate::fast::mul_wide(m, far.0);
-    let pe = e + far.1;
-    if crate::fast::bits64(pm) as i32 + pe > MAX_T_LOG2 {
-        return Err(Error::DepthRange);
-    }
-    Ok((pm, pe))
-}
-
 /// Rows whose pixel centre lies in the snapped vertices' y-range (possibly empty: first > last).
 pub(crate) fn rows_of(p: &[Sub; 3]) -> (i32, i32) {
     let ymin = p[0].y.min(p[1].y).min(p[2].y);
@@ -197,12 +185,21 @@ impl<R: WSpan> Rasterizer<R> {
         let mut p = [Sub { x: 0, y: 0 }; N];
         let mut on_grid = true;
         let mut tm = [(0u64, 0i32); N];
+        // The largest integer bit count of the `t` (0 for values below 1), for F below.
+        let mut int_bits = 0;
         for k in 0..N {
-            let r = v[k].rhw_exact()?;
+            let (m, e) = v[k].rhw_exact()?;
             let (x, y, exact) = v[k].snapped_exact()?;
             p[k] = Sub { x, y };
             on_grid &= exact;
-            tm[k] = t_of(r, (fm, fe))?;
+            // `t = rhw W_far` as an exact product of the mantissas (`m > 0`, `fm > 0`), `pm 2^pe`, and its bit count.
+            let (pm, pe) = (crate::fast::mul_wide(m, fm), e + fe);
+            let b = crate::fast::bits64(pm) as i32 + pe;
+            if b > MAX_T_LOG2 {
+                return Err(Error::DepthRange);
+            }
+            int_bits = int_bits.max(b);
+            tm[k] = (pm, pe);
         }
         let mut q = [Sub { x: 0, y: 0 }; N];
         let (mut dbits, mut dorigin) = (SUBPIXEL_BITS, (0, 0));
@@ -221,11 +218,6 @@ impl<R: WSpan> Rasterizer<R> {
             }
         }
         // F = 61 - bits(floor(t_max)), t_max < 2^30.
-        let int_bits = tm
-            .iter()
-            .map(|&(m, e)| (crate::fast::bits64(m) as i32 + e).max(0))
-            .max()
-            .unwrap_or(0);
         let frac = (61 - int_bits) as u32;
         let t = tm.map(|(m, e)| round_shift(m, e + frac as i32) as i64);
         Ok(Setup {
