@@ -670,9 +670,9 @@ fn depth_plane(
 /// Two ways to these values, the same bound: [`t_at_snapped_wide`] (described here) and [`t_at_snapped_narrow`],
 /// which falls back to the wide way where it cannot vouch for its result. The narrow way is `NARROW`, the choice of
 /// the strategy that seeds its reciprocal by division ([`crate::recip::FastDiv`], for cores with `UMULL` and a divider):
-/// on the Cortex-M4 it takes about 60% of the wide way's instructions (W4 3.6% fewer a frame). On the Cortex-M0, whose
-/// 64-bit products are four `MULS` each, it is the dearer (1,491 against 1,241 instructions a call on the terrain), so
-/// [`crate::recip::Fast`] keeps the wide way. The two round differently within the bound, so the strategy decides, and
+/// on the Cortex-M4 it takes about 73% of the wide way's instructions (550 against 753 a call on W4: 3.6% fewer a
+/// frame). On the Cortex-M0, whose 64-bit products are four `MULS` each, it is the dearer (1,491 against 1,241
+/// instructions a call on the terrain), so [`crate::recip::Fast`] keeps the wide way. The two round differently within the bound, so the strategy decides, and
 /// each strategy's frames stay the same on every core.
 #[inline(never)] // once per triangle: out of line, one copy (flash)
 pub(crate) fn t_at_snapped<const NARROW: bool>(s: &Setup) -> Option<[i64; 3]> {
