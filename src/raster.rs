@@ -672,8 +672,8 @@ fn depth_plane(
 /// the strategy that seeds its reciprocal by division ([`crate::recip::FastDiv`], for cores with `UMULL` and a divider):
 /// on the Cortex-M4 it takes about 73% of the wide way's instructions (550 against 753 a call on W4: 3.6% fewer a
 /// frame). On the Cortex-M0, whose 64-bit products are four `MULS` each, it is the dearer (1,491 against 1,241
-/// instructions a call on the terrain), so [`crate::recip::Fast`] keeps the wide way. The two round differently within the bound, so the strategy decides, and
-/// each strategy's frames stay the same on every core.
+/// instructions a call on the terrain), so [`crate::recip::Fast`] keeps the wide way. The two round differently within
+/// the bound, so the strategy decides, and each strategy's frames stay the same on every core.
 #[inline(never)] // once per triangle: out of line, one copy (flash)
 pub(crate) fn t_at_snapped<const NARROW: bool>(s: &Setup) -> Option<[i64; 3]> {
     if !NARROW {
@@ -726,8 +726,9 @@ fn shr_u64(v: u64, s: u32) -> u64 {
     }
 }
 
-/// [`t_at_snapped`] in 32- and 64-bit pieces with a bound checked per triangle; `None` where that bound is not small
-/// enough (or the plane is not gentle), and the caller then takes [`t_at_snapped_wide`].
+/// [`t_at_snapped`] in 32- and 64-bit pieces with a bound checked per triangle: the values ([`Narrow::Done`]), a plane
+/// certainly too steep ([`Narrow::Steep`]), or [`Narrow::Unsure`] where the bound is not small enough, and the caller
+/// then takes [`t_at_snapped_wide`].
 ///
 /// `c_k = (gx rx_k + gy ry_k) / A` with the gradient's numerators `gx = d1 e2y - d2 e1y`, `gy = d2 e1x - d1 e2x`
 /// (`d_i = t_i - t_0`, `e_i = q_i - q_0`, `A` the doubled area, exact in `i64`). Here:
@@ -767,12 +768,12 @@ fn t_at_snapped_narrow(s: &Setup) -> Narrow {
     let su = (bits64(gx.unsigned_abs() | gy.unsigned_abs()) as i32 - 30).max(0) as u32;
     let (ggx, ggy) = (sar_to_i32(gx, su), sar_to_i32(gy, su)); // |G| <= 2^30
     let r = [0, 1, 2].map(|k| snap_rounding(p[k], q[k], s.dbits, s.dorigin));
+    // R, below 2^22; W, below 2^32 (two magnitudes below 2^31 each).
     let rr = r
         .iter()
         .map(|&(x, y)| x.unsigned_abs() + y.unsigned_abs())
         .max()
-        .unwrap_or(0); // below 2^22
-                       // Below 2^32 (two magnitudes below 2^31 each).
+        .unwrap_or(0);
     let w = (e1y.unsigned_abs() + e2y.unsigned_abs()).max(e1x.unsigned_abs() + e2x.unsigned_abs());
     let a = area.unsigned_abs();
     // 2^sd (2^su + W) R / |A| <= 2^(lt - 36), compared exactly: `bn = (2^su + W) R` below 2^55 (`su <= 32`), `a`
@@ -1496,9 +1497,9 @@ mod tests {
             let check = |out: [i64; 3], how: &str| {
                 for j in 0..3 {
                     let (rx, ry) = snap_rounding(s.p[j], s.q[j], s.dbits, s.dorigin);
-                    let num = gx * rx as i128 + gy * ry as i128; // c = num / a
-                    let err = ((out[j] as i128 - t[j]) * a - num).abs(); // |c' - c| |a|
-                                                                         // Bound: T_min 2^-35 |a|, compared without dividing (both below 2^127).
+                    // c = num / a; |c' - c| |a| against the bound T_min 2^-35 |a|, without dividing (below 2^127).
+                    let num = gx * rx as i128 + gy * ry as i128;
+                    let err = ((out[j] as i128 - t[j]) * a - num).abs();
                     let bound = (t_min >> 35) * a.abs();
                     assert!(err <= bound, "{how} {k} vertex {j}: {err} > {bound}");
                 }
