@@ -146,78 +146,67 @@ impl Edge {
     }
 }
 
-/// One edge's column bound on the current row, walked row by row as [`Edge`] walks `q`: `b = q` for a left edge (the
-/// first column it admits is `-b`), `b = q + 1` for a right edge (one past the last), so that both step alike,
-/// `b += sb`, and `b += 1` on a carry of the remainder (no per-edge increment to keep: one register fewer per edge in
-/// the row loop). The small triangles' row loop (`crate::small`) keeps three of these in fixed slots instead of
-/// matching on [`Side`] per row.
+/// One edge's column bound on the current row in 32.32 fixed point, for the small triangles' rows on cores that divide
+/// (`crate::small`): the walk of [`Edge::step`] with one 64-bit add a row instead of a quotient, a remainder and a carry.
+///
+/// The value is `ceil(2^32 N / D)` at set-up (plus `2^32` for a right edge, whose bound is `q + 1`), and the step
+/// `ceil(2^32 S / D)` (`S = 256 B` the growth of `N` a row), so after `k` rows it exceeds `2^32 N / D` by
+/// `delta < (k + 1)` units of `2^-32`. `N / D` is a multiple of `1 / D`, so its floor is the value's integer part
+/// (`>> 32`) while `delta 2^-32 < 1 / D`: with `D = 256 |A| < 2^23` (a box under 127 px high) and at most 126 rows,
+/// `127 2^-32 < 2^-25 < 2^-23`. The same columns as [`Edge`]'s walk, exactly (the unit tests compare them).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Bound {
-    b: i32,
-    r: i32,
-    d: i32,
-    sb: i32,
-    sr: i32,
+pub(crate) struct Fixed {
+    v: i64,
+    s: i64,
 }
 
-impl Bound {
-    /// A bound that never binds and never moves: a left (lower) bound for a horizontal edge's slot.
-    pub const NONE: Bound = Bound {
-        b: i32::MAX / 2,
-        r: 0,
-        d: 1,
-        sb: 0,
-        sr: 0,
-    };
-
-    /// The edge's bound and side ([`Bound::NONE`] for a horizontal edge).
+impl Fixed {
+    /// The bound of a non-horizontal edge set up by [`Edge::new_small`] (`None` for a horizontal one).
     #[inline(always)]
-    pub fn of(e: &Edge) -> (Side, Bound) {
+    pub fn of(e: &Edge) -> Option<Fixed> {
+        // `q` for a left edge (its first column is `-q`), `q + 1` for a right edge (one past its last).
         let b = match e.side {
             Side::Left => e.q,
             Side::Right => e.q + 1,
-            Side::Flat => return (Side::Flat, Bound::NONE),
+            Side::Flat => return None,
         };
-        (
-            e.side,
-            Bound {
-                b,
-                r: e.r,
-                d: e.d,
-                sb: e.step_q,
-                sr: e.step_r,
-            },
-        )
+        // `D = 256 |A|`, `|A| >= 1` for an edge that is not horizontal.
+        let a = core::num::NonZeroU32::new((e.d as u32) >> 8)?;
+        Some(Fixed {
+            v: ((b as i64) << 32) + ceil_frac(e.r as u32, a) as i64,
+            s: ((e.step_q as i64) << 32) + ceil_frac(e.step_r as u32, a) as i64,
+        })
     }
 
     /// A left edge's first admitted column on the current row (`-q`).
     #[inline(always)]
     pub fn lo(&self) -> i32 {
-        -self.b
+        -((self.v >> 32) as i32)
     }
 
     /// A right edge's column one past its last admitted one on the current row (`q + 1`).
     #[inline(always)]
     pub fn hi(&self) -> i32 {
-        self.b
+        (self.v >> 32) as i32
     }
 
-    /// Of two left edges' bounds, the larger first column (`-max(-a, -b) = min(a, b)`): one `min` and one negation.
-    #[inline(always)]
-    pub fn lo2(&self, o: &Bound) -> i32 {
-        -self.b.min(o.b)
-    }
-
-    /// Moves to the next row (the walk of [`Edge::step`]).
+    /// Moves to the next row.
     #[inline(always)]
     pub fn step(&mut self) {
-        self.b += self.sb;
-        self.r += self.sr;
-        if self.r >= self.d {
-            self.r -= self.d;
-            self.b += 1;
-        }
+        self.v = self.v.wrapping_add(self.s);
     }
+}
+
+/// `ceil(2^32 r / D)` for `D = 256 a` and `0 <= r < D < 2^23`, exactly, by two 32-bit divisions: `2^32 r / D =
+/// 2^24 r / a`; the first takes `2^8 r < 2^31` (quotient below `2^16`, as `r < 2^8 a`), the second the remainder's
+/// next 16 bits. Below `2^32` (`r <= D - 1`).
+#[inline(always)]
+fn ceil_frac(r: u32, a: core::num::NonZeroU32) -> u32 {
+    let x1 = r << 8;
+    let q1 = x1 / a;
+    let x2 = (x1 - q1 * a.get()) << 16;
+    let q2 = x2 / a;
+    (q1 << 16) + q2 + u32::from(x2 != q2 * a.get())
 }
 
 /// The rows `(first, last)` of a triangle with positive doubled area (`p` oriented), from the rows whose centre lies
@@ -233,4 +222,69 @@ pub(crate) fn flat_rows(p: &[Sub; 3], (first, mut last): (i32, i32)) -> (i32, i3
         }
     }
     (first, last)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `ceil_frac` is `ceil(2^32 r / D)` exactly: every `r` of small `D`, and random `r`, `D` up to the largest.
+    #[test]
+    fn ceil_frac_is_exact() {
+        let check = |r: u32, a: u32| {
+            let d = 256 * a as u64;
+            let want = ((r as u64) << 32).div_ceil(d);
+            let got = ceil_frac(r, core::num::NonZeroU32::new(a).unwrap());
+            assert_eq!(got as u64, want, "r {r} a {a}");
+        };
+        for a in 1..40 {
+            for r in 0..256 * a {
+                check(r, a);
+            }
+        }
+        let mut rnd = crate::xorshift(0x0123_4567_89ab_cdef);
+        for _ in 0..1_000_000 {
+            let a = 1 + (rnd() % ((1 << 15) - 1)) as u32; // |A| below 2^15: a box under 128 px high
+            let r = (rnd() % (256 * a as u64)) as u32;
+            check(r, a);
+        }
+        check(256 * 32767 - 1, 32767);
+    }
+
+    /// The fixed-point bound walks the same columns as the exact quotient-and-remainder walk, row by row, for 126
+    /// rows (the small triangles' most), on random small edges of either side, set up at any row.
+    #[test]
+    fn fixed_bounds_walk_the_exact_columns() {
+        let mut rnd = crate::xorshift(0xfeed_5eed_dead_beef);
+        let mut coord = move |n: i64| (rnd() % n as u64) as i32;
+        for _ in 0..200_000 {
+            // Vertices in a box under 32 x 126 px, relative to origin (ox, oy).
+            let (ox, oy) = (coord(600) - 300, coord(600) - 300);
+            let sub = |x: i32, y: i32| Sub {
+                x: 256 * ox + x,
+                y: 256 * oy + y,
+            };
+            let (a, b) = (
+                sub(coord(32 * 256), coord(126 * 256)),
+                sub(coord(32 * 256), coord(126 * 256)),
+            );
+            let j = oy + coord(8);
+            let mut e = Edge::new_small(a, b, j, ox, oy);
+            let Some(mut f) = Fixed::of(&e) else {
+                assert!(matches!(e.side, Side::Flat));
+                continue;
+            };
+            for _ in 0..126 {
+                let want = match e.side {
+                    Side::Left => e.q,
+                    Side::Right => e.q + 1,
+                    Side::Flat => unreachable!(),
+                };
+                assert_eq!(f.hi(), want, "{a:?} {b:?}");
+                assert_eq!(f.lo(), -want);
+                e.step();
+                f.step();
+            }
+        }
+    }
 }

@@ -13,18 +13,10 @@
 //! ```
 //! use embedded_graphics_core::pixelcolor::Rgb565;
 //! use embedded_graphics_core::prelude::*;
-//! use wraster::{DepthStore, Rasterizer, RenderState, Vertex};
+//! use wraster::{ColorBand, DepthStore, Rasterizer, RenderState, Vertex};
 //!
-//! # struct Screen([Rgb565; 32 * 16]);
-//! # impl OriginDimensions for Screen { fn size(&self) -> Size { Size::new(32, 16) } }
-//! # impl DrawTarget for Screen {
-//! #     type Color = Rgb565; type Error = core::convert::Infallible;
-//! #     fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(&mut self, px: I) -> Result<(), Self::Error> {
-//! #         for Pixel(p, c) in px { if let Ok(x) = usize::try_from(p.x + p.y * 32) { if x < 512 { self.0[x] = c } } }
-//! #         Ok(())
-//! #     }
-//! # }
-//! # let mut screen = Screen([Rgb565::BLACK; 32 * 16]);
+//! let mut px = [0u16; 32 * 16]; // RGB565, what the display takes
+//! let mut screen = ColorBand::<Rgb565>::new(&mut px, 32, 16)?;
 //! let mut depth = DepthStore::<32, 16>::new();
 //! let mut r: Rasterizer = Rasterizer::new(RenderState::new(10.0, 1000.0)?);
 //! let tri = [
@@ -34,6 +26,7 @@
 //! ];
 //! let stats = r.draw(&mut screen, &mut depth.view(), &tri)?;
 //! assert!(stats.written > 100);
+//! assert_eq!(px[2 * 32 + 2], 0xF800); // a pixel inside, red
 //! # Ok::<(), wraster::Error>(())
 //! ```
 //!
@@ -76,14 +69,8 @@
 //! use wraster::clip::Viewport;
 //! use wraster::mesh::{Colors, Mesh, Projected};
 //! use wraster::projection::{Camera, Mat4};
-//! use wraster::{DepthStore, Rasterizer};
+//! use wraster::{ColorBand, DepthStore, Rasterizer};
 //!
-//! # struct Screen;
-//! # impl OriginDimensions for Screen { fn size(&self) -> Size { Size::new(64, 48) } }
-//! # impl DrawTarget for Screen {
-//! #     type Color = Rgb565; type Error = core::convert::Infallible;
-//! #     fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(&mut self, _: I) -> Result<(), Self::Error> { Ok(()) }
-//! # }
 //! // A tetrahedron, counter-clockwise seen from outside, one colour per face.
 //! let positions = [[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]];
 //! let indices = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]];
@@ -94,6 +81,8 @@
 //! let camera = Camera::look_at([0.0, 0.0, 4.0], [0.0; 3], [0.0, 1.0, 0.0],
 //!                              core::f32::consts::FRAC_PI_3, 64.0 / 48.0, 0.5, 100.0)?;
 //! let mut r: Rasterizer = Rasterizer::new(camera.render_state()?); // depth range 0.5..100, back faces culled
+//! let mut px = [0u16; 64 * 48];
+//! let mut screen = ColorBand::<Rgb565>::new(&mut px, 64, 48)?;
 //! let mut depth = DepthStore::<64, 48>::new();
 //! let mut scratch = [Projected::default(); 4]; // one per vertex, caller-owned: no allocation
 //! let vp = Viewport::new(0.0, 0.0, 64.0, 48.0);
@@ -101,7 +90,7 @@
 //!     depth.view().clear();
 //!     let model = Mat4::rotation_y(0.5 * frame as f32) * Mat4::translation([0.0, 0.0, -1.0]);
 //!     let m = camera.model_matrix(&model);
-//!     let stats = r.draw_mesh(&mut Screen, &mut depth.view(), &mesh, &m, &vp, &mut scratch)?;
+//!     let stats = r.draw_mesh(&mut screen, &mut depth.view(), &mesh, &m, &vp, &mut scratch)?;
 //!     assert!(stats.written > 100 && stats.culled >= 1);
 //! }
 //! # Ok::<(), wraster::Error>(())
@@ -133,6 +122,7 @@ pub mod recip;
 pub mod scenes;
 mod small;
 mod state;
+pub mod target;
 mod transform;
 
 /// A xorshift64 generator for the unit tests. The closure is `Copy`: a copy goes on from the same state, so a view
@@ -157,3 +147,4 @@ pub use raster::{
     depth_grid_bits, row_range, Rasterizer, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS,
 };
 pub use state::{Compare, Cull, DepthMode, DepthRange, RenderState, MAX_T};
+pub use target::ColorBand;

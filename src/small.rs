@@ -11,9 +11,9 @@
 //! so the inside is positive, less the top-left bias) are evaluated exactly in `i32` relative to the box's origin
 //! pixel: `x` below `2^14` and `y` below `2^15` sub-pixels, `|A_k| < 2^15`, `|B_k| < 2^13`, so
 //! `|E_k| < 2^29 + 2^28` at every pixel centre of the box. A pixel is covered iff all three are `>= 0`: the top-left
-//! rule, exactly the general walk's pixels. Each row's covered run is found either from the edges' column bounds,
-//! walked row by row with a quotient and a remainder (`crate::edge`; one 32-bit division per edge and step at
-//! set-up), or by scanning the row from the box's left column with the edge functions alone, past the uncovered
+//! rule, exactly the general walk's pixels. Each row's covered run is found either from the column bounds of the two
+//! edges that bound the row (the long edge and one short one, [`Halves`]), walked in 32.32 fixed point that gives
+//! the exact columns (`crate::edge::Fixed`; 32-bit divisions at set-up, one add a row), or by scanning the row from the box's left column with the edge functions alone, past the uncovered
 //! pixels, then to the end of the run (the triangle is convex): [`ROWS_BY_DIVISION`] says which core takes which.
 //! The depth loop then walks the run.
 //!
@@ -55,7 +55,7 @@ use embedded_graphics_core::prelude::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 
 use crate::depth::DepthBuffer;
-use crate::edge::{flat_rows, Bound, Edge, Side, Sub};
+use crate::edge::{flat_rows, Edge, Fixed, Side, Sub};
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
 use crate::fast::{bits64 as bits, fresh61, lz_small, mul_hi, mul_wide, FreshSeed};
@@ -216,16 +216,10 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
         lz: (lz_of(tp_min) == lz).then_some(lz),
     };
     if DIV {
-        let Some(dda) = Dda::new(&pa, j0, ox, oy) else {
+        let Some(halves) = Halves::new(&pa, j0, j1, ox, oy) else {
             return Ok(None);
         };
-        // The third edge's side as a constant of the row loop (one copy each): no per-row choice between the bounds.
-        if dda.x_left {
-            walk.rows::<S, D, _>(target, depth, Sided::<true>(dda), color)
-        } else {
-            walk.rows::<S, D, _>(target, depth, Sided::<false>(dda), color)
-        }
-        .map(Some)
+        walk.rows::<S, D, _>(target, depth, halves, color).map(Some)
     } else {
         walk.rows::<S, D, _>(target, depth, scan, color).map(Some)
     }
@@ -243,73 +237,102 @@ trait Runs {
     fn step(&mut self);
 }
 
-/// Each edge's column bound, walked row by row with a quotient and a remainder (`crate::edge`), so a row's run is
-/// found without touching its pixels. A triangle of positive area has a left and a right edge (the three `A` sum to
-/// 0 and are not all 0); the third is either, or horizontal (a bound that never binds).
-struct Dda {
-    l: Bound,
-    r: Bound,
-    x: Bound,
-    x_left: bool,
+/// Each row's covered run from the two edges that bound it: sorted by `y`, the triangle's rows above its middle
+/// vertex lie between the long edge (top to bottom vertex) and the top short edge, and the rows from it down between
+/// the long edge and the bottom short edge. (Above the middle vertex the region between the long and the top edge lies
+/// strictly inside the bottom edge's half-plane, which it meets only at the middle vertex, so that edge's function is
+/// positive there and it binds no pixel; likewise below. On the row through the middle vertex both short edges cross
+/// the row at the vertex, on the same side, with the same bias: either gives the same bound.) Each bound is walked
+/// in 32.32 fixed point ([`Fixed`]: the exact columns, one 64-bit add a row), so a row costs two adds, and the
+/// bottom edge takes the top edge's place once, at the middle vertex's row.
+struct Halves {
+    l: Fixed,
+    r: Fixed,
+    /// The bottom short edge, positioned at its first row, and whether it replaces the right bound (else the left).
+    next: Fixed,
+    next_right: bool,
+    /// Rows before `next` takes over (`i32::MAX`: never, within the triangle's rows).
+    until: i32,
 }
 
-impl Dda {
-    /// The oriented snapped triangle `p`'s bounds on row `j0` (`None` for a degenerate triangle, which the caller
-    /// has already culled).
-    fn new(p: &[Sub; 3], j0: i32, ox: i32, oy: i32) -> Option<Dda> {
-        let e = [
-            Edge::new_small(p[0], p[1], j0, ox, oy),
-            Edge::new_small(p[1], p[2], j0, ox, oy),
-            Edge::new_small(p[2], p[0], j0, ox, oy),
-        ];
-        let left = |k: usize| matches!(e[k].side, Side::Left);
-        let right = |k: usize| matches!(e[k].side, Side::Right);
-        let li = if left(0) {
+impl Halves {
+    /// The oriented snapped triangle `p`'s bounds from row `j0` to `j1` (`None` where the triangle is not as the
+    /// rows need: not reached for a triangle of positive area, whose long edge is not horizontal and whose short
+    /// edges lie on the other side; the general path then draws it).
+    fn new(p: &[Sub; 3], j0: i32, j1: i32, ox: i32, oy: i32) -> Option<Halves> {
+        let t = if p[0].y <= p[1].y && p[0].y <= p[2].y {
             0
-        } else if left(1) {
+        } else if p[1].y <= p[2].y {
             1
         } else {
             2
         };
-        let ri = if right(0) {
-            0
-        } else if right(1) {
-            1
+        let b = if p[(t + 1) % 3].y >= p[(t + 2) % 3].y {
+            (t + 1) % 3
         } else {
-            2
+            (t + 2) % 3
         };
-        if !left(li) || !right(ri) {
+        let m = 3 - t - b;
+        // The directed edge `k -> k + 1` joining vertices `u` and `v`, positioned at row `j`.
+        #[inline(always)]
+        fn edge(p: &[Sub; 3], u: usize, v: usize, j: i32, o: (i32, i32)) -> Option<(bool, Fixed)> {
+            let k = if (u + 1) % 3 == v { u } else { v };
+            let e = Edge::new_small(p[k], p[(k + 1) % 3], j, o.0, o.1);
+            Some((matches!(e.side, Side::Left), Fixed::of(&e)?))
+        }
+        let edge = |u: usize, v: usize, j: i32| edge(p, u, v, j, (ox, oy));
+        // The first row whose centre is at or below the middle vertex.
+        let jm = (p[m].y - 128 + 255) >> SUBPIXEL_BITS;
+        let (long_left, long) = edge(t, b, j0)?;
+        let (short_left, short) = if jm > j0 {
+            edge(t, m, j0)?
+        } else {
+            edge(m, b, j0)?
+        };
+        let (next, until) = if jm > j0 && jm <= j1 {
+            let (next_left, next) = edge(m, b, jm)?;
+            if next_left == long_left {
+                return None;
+            }
+            (next, jm - j0)
+        } else {
+            (short, i32::MAX)
+        };
+        if short_left == long_left {
             return None;
         }
-        let xi = 3 - li - ri;
-        let (x_side, x) = Bound::of(&e[xi]);
-        Some(Dda {
-            l: Bound::of(&e[li]).1,
-            r: Bound::of(&e[ri]).1,
-            x,
-            x_left: !matches!(x_side, Side::Right),
+        let (l, r) = if long_left {
+            (long, short)
+        } else {
+            (short, long)
+        };
+        Some(Halves {
+            l,
+            r,
+            next,
+            next_right: long_left,
+            until,
         })
     }
 }
 
-/// A [`Dda`] whose third edge bounds the left side (`X_LEFT`) or the right one.
-struct Sided<const X_LEFT: bool>(Dda);
-
-impl<const X_LEFT: bool> Runs for Sided<X_LEFT> {
+impl Runs for Halves {
     #[inline(always)]
     fn run(&self, _: i32) -> (i32, i32) {
-        let d = &self.0;
-        if X_LEFT {
-            (d.l.lo2(&d.x), d.r.hi())
-        } else {
-            (d.l.lo(), d.r.hi().min(d.x.hi()))
-        }
+        (self.l.lo(), self.r.hi())
     }
     #[inline(always)]
     fn step(&mut self) {
-        self.0.l.step();
-        self.0.r.step();
-        self.0.x.step();
+        self.l.step();
+        self.r.step();
+        self.until -= 1;
+        if self.until == 0 {
+            if self.next_right {
+                self.r = self.next;
+            } else {
+                self.l = self.next;
+            }
+        }
     }
 }
 

@@ -9,17 +9,15 @@
 
 use core::fmt::Write;
 
-use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::geometry::{Dimensions, OriginDimensions, Point, Size};
 use embedded_graphics_core::pixelcolor::raw::RawU16;
-use embedded_graphics_core::pixelcolor::{IntoStorage, Rgb565};
-use embedded_graphics_core::primitives::Rectangle;
-use embedded_graphics_core::Pixel;
+use embedded_graphics_core::pixelcolor::Rgb565;
 use wraster::clip::Viewport;
 use wraster::format::W16;
 use wraster::mesh::{Colors, Mesh, MeshFrame, Projected};
 use wraster::recip::SpanRecip;
-use wraster::{Codec, DepthBuffer, Error, Packed, Rasterizer, RenderState, Stats, Vertex};
+use wraster::{
+    Codec, ColorBand, DepthBuffer, Error, Packed, Rasterizer, RenderState, Stats, Vertex,
+};
 
 /// A baked triangle: `(x, y, rhw)` bit patterns per vertex, the RGB565 colour, the rows it can cover.
 pub struct Tri {
@@ -101,86 +99,6 @@ impl Tri {
             rhw: f32::from_bits(rhw),
             color: c,
         })
-    }
-}
-
-/// A colour band: rows `[y0, y0 + h)` of a `WIDTH`-wide frame. Writes outside it are dropped (never out of bounds).
-pub struct Band<'a> {
-    px: &'a mut [u16],
-    y0: i32,
-    h: i32,
-}
-
-impl<'a> Band<'a> {
-    /// `px.len()` must be `WIDTH * h`.
-    pub fn new(px: &'a mut [u16], y0: i32) -> Self {
-        let h = (px.len() / WIDTH as usize) as i32;
-        Band { px, y0, h }
-    }
-}
-
-impl OriginDimensions for Band<'_> {
-    fn size(&self) -> Size {
-        Size::new(WIDTH as u32, (self.y0 + self.h) as u32)
-    }
-}
-
-impl DrawTarget for Band<'_> {
-    type Color = Rgb565;
-    type Error = core::convert::Infallible;
-    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(
-        &mut self,
-        pixels: I,
-    ) -> Result<(), Self::Error> {
-        for Pixel(p, c) in pixels {
-            let r = p.y - self.y0;
-            if (0..self.h).contains(&r) && (0..WIDTH as i32).contains(&p.x) {
-                self.px[r as usize * WIDTH as usize + p.x as usize] = c.into_storage();
-            }
-        }
-        Ok(())
-    }
-    #[inline]
-    fn fill_solid(&mut self, area: &Rectangle, c: Rgb565) -> Result<(), Self::Error> {
-        let v = c.into_storage();
-        let x0 = area.top_left.x.max(0) as usize;
-        let x1 = ((area.top_left.x + area.size.width as i32).min(WIDTH as i32)).max(0) as usize;
-        for y in area.top_left.y..area.top_left.y + area.size.height as i32 {
-            let r = y - self.y0;
-            if (0..self.h).contains(&r) && x0 < x1 {
-                let base = r as usize * WIDTH as usize;
-                self.px[base + x0..base + x1].fill(v);
-            }
-        }
-        Ok(())
-    }
-}
-
-/// A [`Band`] whose bounding box is its own rows: a draw without a depth buffer takes its rows from the target, and
-/// would otherwise walk (and count) every row above the band. (`Band` itself keeps its size from row 0: changing it
-/// moves the standard runs' code generation.)
-struct OwnRows<'b, 'a>(&'b mut Band<'a>);
-
-impl Dimensions for OwnRows<'_, '_> {
-    fn bounding_box(&self) -> Rectangle {
-        Rectangle::new(
-            Point::new(0, self.0.y0),
-            Size::new(WIDTH as u32, self.0.h as u32),
-        )
-    }
-}
-
-impl DrawTarget for OwnRows<'_, '_> {
-    type Color = Rgb565;
-    type Error = core::convert::Infallible;
-    fn draw_iter<I: IntoIterator<Item = Pixel<Rgb565>>>(
-        &mut self,
-        pixels: I,
-    ) -> Result<(), Self::Error> {
-        self.0.draw_iter(pixels)
-    }
-    fn fill_solid(&mut self, area: &Rectangle, c: Rgb565) -> Result<(), Self::Error> {
-        self.0.fill_solid(area, c)
     }
 }
 
@@ -329,7 +247,7 @@ pub fn run_scene_bounded<R: SpanRecip, C: Counter>(
         let buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
         let mut buf = with_bound(buf, &mut *bound, h)?;
         buf.clear();
-        let mut band = Band::new(color, y0 as i32);
+        let mut band = ColorBand::<Rgb565>::band(color, WIDTH, y0 as i32, h)?;
         let (b0, b1) = (y0 as i32, (y0 + h) as i32 - 1);
         counter.start();
         for t in scene.tris {
@@ -340,10 +258,10 @@ pub fn run_scene_bounded<R: SpanRecip, C: Counter>(
         instructions += counter.stop();
         let w = WIDTH as usize;
         for row in 0..h as usize {
-            hash.words(&band.px[row * w..(row + 1) * w]);
+            hash.words(&band.pixels()[row * w..(row + 1) * w]);
             hash.words(&buf.data()[row * w..(row + 1) * w]);
         }
-        on_band(y0, band.px);
+        on_band(y0, band.pixels());
         bands += 1;
         y0 += h;
     }
@@ -439,18 +357,18 @@ fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
         let n = w * h as usize;
         let color = &mut color[..n];
         color.fill(0);
-        let mut band = Band::new(color, y0 as i32);
+        let mut band = ColorBand::<Rgb565>::band(color, WIDTH, y0 as i32, h)?;
         let (b0, b1) = (y0 as i32, (y0 + h) as i32 - 1);
         if KIND == NO_DEPTH {
             counter.start();
             let res = tris((b0, b1), &mut |v| {
-                *stats += r.draw_format::<W16, _>(&mut OwnRows(&mut band), None, v)?;
+                *stats += r.draw_format::<W16, _>(&mut band, None, v)?;
                 Ok(())
             });
             instructions += counter.stop();
             res?;
             for row in 0..h as usize {
-                hash.words(&band.px[row * w..(row + 1) * w]);
+                hash.words(&band.pixels()[row * w..(row + 1) * w]);
             }
         } else if KIND == LEAN_W16 {
             let (depth, rest) = split_depth(depth, n)?;
@@ -465,7 +383,7 @@ fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
             instructions += counter.stop();
             res?;
             for row in 0..h as usize {
-                hash.words(&band.px[row * w..(row + 1) * w]);
+                hash.words(&band.pixels()[row * w..(row + 1) * w]);
                 hash.words(&buf.data()[row * w..(row + 1) * w]);
             }
         } else {
@@ -483,7 +401,7 @@ fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
             let rb = w * F::BYTES;
             let bytes: &[u8] = bytemuck::cast_slice(&*depth);
             for row in 0..h as usize {
-                hash.words(&band.px[row * w..(row + 1) * w]);
+                hash.words(&band.pixels()[row * w..(row + 1) * w]);
                 hash.bytes(&bytes[row * rb..(row + 1) * rb]);
             }
         }
@@ -768,16 +686,16 @@ fn mesh_frame_in_bands<R: SpanRecip, C: Counter>(
         let buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
         let mut buf = with_bound(buf, &mut *bound, h)?;
         buf.clear();
-        let mut band = Band::new(color, y0 as i32);
+        let mut band = ColorBand::<Rgb565>::band(color, WIDTH, y0 as i32, h)?;
         counter.start();
         let s = r.draw_mesh_frame(&mut band, &mut buf, frame);
         instructions += counter.stop();
         *stats += s?;
         for row in 0..h as usize {
-            hash.words(&band.px[row * w..(row + 1) * w]);
+            hash.words(&band.pixels()[row * w..(row + 1) * w]);
             hash.words(&buf.data()[row * w..(row + 1) * w]);
         }
-        on_band(y0, band.px);
+        on_band(y0, band.pixels());
         bands += 1;
         y0 += h;
     }
