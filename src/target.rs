@@ -101,17 +101,16 @@ where
         self.px.fill(color.into().into_inner());
     }
 
-    /// `area` clipped to the band, filled with the raw colour `v`, one slice fill a row.
+    /// The rectangle at `(x, y)`, `w` by `h`, clipped to the band, filled with the raw colour `v`, one slice fill a
+    /// row. (Scalars, not a `Rectangle`: the inline fast path then builds none.)
     #[inline(never)]
-    fn fill_clipped(&mut self, area: &Rectangle, v: Raw<C>) {
-        let x = area.top_left.x;
+    fn fill_clipped(&mut self, x: i32, y: i32, w: u32, h: u32, v: Raw<C>) {
         let x0 = x.max(0) as usize;
-        let x1 = (x.saturating_add_unsigned(area.size.width).max(0) as usize).min(self.width);
+        let x1 = (x.saturating_add_unsigned(w).max(0) as usize).min(self.width);
         if x0 >= x1 {
             return;
         }
-        let y = area.top_left.y;
-        for j in y..y.saturating_add_unsigned(area.size.height) {
+        for j in y..y.saturating_add_unsigned(h) {
             if let Some(r) = self.row_index(j) {
                 let base = r * self.width;
                 if let Some(run) = self.px.get_mut(base + x0..base + x1) {
@@ -192,7 +191,8 @@ where
             }
             return Ok(());
         }
-        self.fill_clipped(area, v);
+        let (p, size) = (area.top_left, area.size);
+        self.fill_clipped(p.x, p.y, size.width, size.height, v);
         Ok(())
     }
 
