@@ -265,37 +265,38 @@ impl Halves {
     /// rows need: not reached for a triangle of positive area, whose long edge is not horizontal and whose short
     /// edges lie on the other side; the general path then draws it).
     fn new(p: &[Sub; 3], j0: i32, j1: i32, ox: i32, oy: i32) -> Option<Halves> {
-        let t = if p[0].y <= p[1].y && p[0].y <= p[2].y {
-            0
+        // Rotated (the orientation kept) so that vertex 0 is a topmost one; the directed edges are then `0 -> 1`,
+        // `1 -> 2`, `2 -> 0`, and the bottom vertex is 1 or 2.
+        let q = if p[0].y <= p[1].y && p[0].y <= p[2].y {
+            *p
         } else if p[1].y <= p[2].y {
-            1
+            [p[1], p[2], p[0]]
         } else {
-            2
+            [p[2], p[0], p[1]]
         };
-        let b = if p[(t + 1) % 3].y >= p[(t + 2) % 3].y {
-            (t + 1) % 3
+        // (long edge, top short edge, bottom short edge, the middle vertex's y).
+        let (long_e, top_e, bottom_e, ym) = if q[1].y >= q[2].y {
+            ((q[0], q[1]), (q[2], q[0]), (q[1], q[2]), q[2].y)
         } else {
-            (t + 2) % 3
+            ((q[2], q[0]), (q[0], q[1]), (q[1], q[2]), q[1].y)
         };
-        let m = 3 - t - b;
-        // The directed edge `k -> k + 1` joining vertices `u` and `v`, positioned at row `j`.
+        // The directed edge `(a, b)`, positioned at row `j`: whether it bounds the left side, and its bound.
         #[inline(always)]
-        fn edge(p: &[Sub; 3], u: usize, v: usize, j: i32, o: (i32, i32)) -> Option<(bool, Fixed)> {
-            let k = if (u + 1) % 3 == v { u } else { v };
-            let e = Edge::new_small(p[k], p[(k + 1) % 3], j, o.0, o.1);
+        fn edge((a, b): (Sub, Sub), j: i32, (ox, oy): (i32, i32)) -> Option<(bool, Fixed)> {
+            let e = Edge::new_small(a, b, j, ox, oy);
             Some((matches!(e.side, Side::Left), Fixed::of(&e)?))
         }
-        let edge = |u: usize, v: usize, j: i32| edge(p, u, v, j, (ox, oy));
+        let edge = |e: (Sub, Sub), j: i32| edge(e, j, (ox, oy));
         // The first row whose centre is at or below the middle vertex.
-        let jm = (p[m].y - 128 + 255) >> SUBPIXEL_BITS;
-        let (long_left, long) = edge(t, b, j0)?;
+        let jm = (ym - 128 + 255) >> SUBPIXEL_BITS;
+        let (long_left, long) = edge(long_e, j0)?;
         let (short_left, short) = if jm > j0 {
-            edge(t, m, j0)?
+            edge(top_e, j0)?
         } else {
-            edge(m, b, j0)?
+            edge(bottom_e, j0)?
         };
         let (next, from) = if jm > j0 && jm <= j1 {
-            let (next_left, next) = edge(m, b, jm)?;
+            let (next_left, next) = edge(bottom_e, jm)?;
             if next_left == long_left {
                 return None;
             }
