@@ -670,13 +670,15 @@ fn skip_run<const UP: bool, const COARSE: bool>(
     const SEG: usize = crate::depth::SEGMENT;
     let n = row.len();
     if !COARSE {
-        for (k, &stored) in row.iter().enumerate() {
+        // Walked by the element, the index found from what is left on leaving: one counter in the loop.
+        let mut px = row.iter();
+        while let Some(&stored) = px.next() {
             if !ruled_out((v >> 32) as u32, stored, lim) {
-                return (k, v, End::Fail);
+                return (n - 1 - px.len(), v, End::Fail);
             }
             v = v.wrapping_add(dv);
             if left_binade::<UP>(v) {
-                return (k + 1, v, End::Binade);
+                return (n - px.len(), v, End::Binade);
             }
         }
         return (n, v, End::Row);
