@@ -204,16 +204,20 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
     let tp_min = tp[0].min(tp[1]).min(tp[2]);
     let lz_of = |t: u64| lz_small(((area2 * t) << sh >> 32) as u32);
     let lz = lz_of(tp_max);
+    let same = lz_of(tp_min) == lz;
+    // Where the leading zeros are the same, `S` is walked pre-shifted by them too ([`Walk::rows`]), in the same
+    // shift: `sh + lz <= 30 + 8` (`sh <= 63 - 1 - 32`, and `S 2^sh >= 2^55` leaves at most 8 leading zeros).
+    let shift = sh + if same { lz } else { 0 };
     let walk = Walk {
         j0,
         j1,
         ox,
-        sr: sr << sh,
-        sx: sx << sh,
-        sy: sy << sh,
+        sr: sr << shift,
+        sx: sx << shift,
+        sy: sy << shift,
         kn,
         s0,
-        lz: (lz_of(tp_min) == lz).then_some(lz),
+        lz: same.then_some(lz),
     };
     if DIV {
         let Some(halves) = Halves::new(&pa, j0, j1, ox, oy) else {
@@ -264,6 +268,7 @@ impl Halves {
     /// The oriented snapped triangle `p`'s bounds from row `j0` to `j1` (`None` where the triangle is not as the
     /// rows need: not reached for a triangle of positive area, whose long edge is not horizontal and whose short
     /// edges lie on the other side; the general path then draws it).
+    #[inline(always)]
     fn new(p: &[Sub; 3], j0: i32, j1: i32, ox: i32, oy: i32) -> Option<Halves> {
         // Rotated (the orientation kept) so that vertex 0 is a topmost one; the directed edges are then `0 -> 1`,
         // `1 -> 2`, `2 -> 0`, and the bottom vertex is 1 or 2.
@@ -405,15 +410,9 @@ impl Walk {
         color: D::Color,
     ) -> Result<Stats, Error> {
         match self.lz {
-            // `S` pre-shifted by its leading zeros (exact: the walk is exact modulo 2^64, and every covered pixel's
-            // shifted `S` has its top bit set), so that each pixel's normalised `m` is the high word.
-            Some(lz) => Walk {
-                sr: self.sr << lz,
-                sx: self.sx << lz,
-                sy: self.sy << lz,
-                ..self
-            }
-            .rows_as::<S, D, R, true>(target, depth, runs, color, lz),
+            // `S` walked pre-shifted by its leading zeros too (exact: the walk is exact modulo 2^64, and every covered
+            // pixel's shifted `S` has its top bit set), so that each pixel's normalised `m` is the high word.
+            Some(lz) => self.rows_as::<S, D, R, true>(target, depth, runs, color, lz),
             None => self.rows_as::<S, D, R, false>(target, depth, runs, color, 0),
         }
     }

@@ -132,9 +132,20 @@ impl DepthRange {
     /// rounding just below zero (a vertex `t` that rounds to 0, `W` beyond `2^61 W_far`) wraps to a `u64` above
     /// `i64::MAX`, which the range test must refuse. (A fuzz finding: with `2^frac W_far / W_near` above `2^64` the
     /// bound saturated at `u64::MAX` and let such a span into the fast loop, whose shift overflowed.)
+    /// In 64-bit pieces (a variable `u128` shift is a long sequence on the 32-bit cores): `t_max_q < 2^95`
+    /// (`far / near <= 2^30` with 64 fraction bits), so its high part `hi = t_max_q >> 32` is below `2^63`, and
+    /// `t_max_q / 2^s = hi 2^(32 - s) + floor(lo / 2^s)` for `s < 32`, at least `2^63` exactly when `hi >= 2^(31 + s)`;
+    /// for `s >= 32` the low part adds less than one unit before the floor.
     pub(crate) fn t_max(&self, frac: u32) -> u64 {
-        let q = self.t_max_q >> (TMAX_FRAC - frac.min(TMAX_FRAC));
-        q.min(i64::MAX as u128) as u64
+        let (hi, lo) = ((self.t_max_q >> 32) as u64, self.t_max_q as u32);
+        let s = TMAX_FRAC - frac.min(TMAX_FRAC); // 0..=64
+        if s >= 32 {
+            hi >> (s - 32)
+        } else if hi >> (31 + s) != 0 {
+            i64::MAX as u64
+        } else {
+            (hi << (32 - s)) | (lo >> s) as u64
+        }
     }
 }
 
@@ -182,5 +193,42 @@ impl RenderState {
             #[cfg(feature = "bias")]
             slope_scale_depth_bias: 0.0,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `t_max` in 64-bit pieces equals its definition, `min(floor(t_max_q / 2^(64 - frac)), 2^63 - 1)` in `u128`, at
+    /// every `frac` for ranges from the narrowest to the widest allowed (the saturation included: wide ranges at
+    /// large `frac`).
+    #[test]
+    fn t_max_is_its_u128_definition() {
+        let mut rnd = crate::xorshift(0x5eed_0f7a_c0de_1234);
+        let mut ranges = std::vec![
+            (1.0f32, 1.0000001f32),
+            (1.0, 2.0),
+            (0.5, 100.0),
+            (1.0, (1u32 << 30) as f32)
+        ];
+        for _ in 0..20_000 {
+            let near = f32::from_bits(0x3000_0000 + (rnd() % 0x1800_0000) as u32);
+            let ratio = 1.0 + (rnd() % (1 << 30)) as f32 / (1u32 << (rnd() % 31) as u32) as f32;
+            ranges.push((near, near * ratio));
+        }
+        let mut checked = 0;
+        for (near, far) in ranges {
+            let Ok(r) = DepthRange::new(near, far) else {
+                continue;
+            };
+            for frac in 0..=70 {
+                let want =
+                    (r.t_max_q >> (TMAX_FRAC - frac.min(TMAX_FRAC))).min(i64::MAX as u128) as u64;
+                assert_eq!(r.t_max(frac), want, "near {near} far {far} frac {frac}");
+            }
+            checked += 1;
+        }
+        assert!(checked > 19_000, "{checked}");
     }
 }
