@@ -262,6 +262,9 @@ mod tests {
             }
         );
         assert!(ColorBand::<Rgb888>::new(&mut px, 0, 2).is_err());
+        // Zero sizes are refused even where the storage matches them.
+        assert!(ColorBand::<Rgb888>::new(&mut [], 0, 2).is_err());
+        assert!(ColorBand::<Rgb888>::new(&mut [], 3, 0).is_err());
         let mut band = ColorBand::<Rgb888>::band(&mut px, 3, -1, 2).unwrap();
         assert_eq!(
             band.bounding_box(),
@@ -269,6 +272,12 @@ mod tests {
         );
         band.clear(Rgb888::WHITE).unwrap();
         assert_eq!(band.pixels(), [0xFF_FFFF; 6]);
+        let shown = std::format!("{band:?}");
+        assert!(
+            shown.starts_with("ColorBand")
+                && shown.contains("width: 3")
+                && shown.contains("y0: -1")
+        );
         band.set_y0(4);
         assert_eq!(band.y0(), 4);
         assert!(band.row(3).is_none() && band.row(6).is_none());
