@@ -10,7 +10,7 @@ pub const W16_FAR: u16 = u16::MAX;
 /// (a whole frame when `y0 = 0` and `height` is the frame's height; a band otherwise).
 /// Element `(x, y)` of the frame is at `(y - y0) * width + x`.
 ///
-/// With feature `coarse`, a buffer may also keep a coarse bound ([`DepthBuffer::with_bound`]): for each aligned
+/// With feature `coarse`, a buffer may also keep a coarse bound (`DepthBuffer::with_bound`): for each aligned
 /// 8-pixel segment of each row, a code at least as large as every code stored in it. The fast tier's W16 span
 /// ([`crate::recip::Fast`], `Less`) rejects a whole segment whose nearest pixel is at or behind its bound before any
 /// per-pixel work.

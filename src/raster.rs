@@ -660,7 +660,7 @@ fn depth_plane(
 /// `T_q(p_k) = t_k + grad T_q . r_k` with `r_k = p_k - q_k` (the snap's rounding against the depth grid, below
 /// `2^(bits - 9) <= 2^21` units). The gradient's numerators `(gx, gy)` are exact (`i64 x i32` products from two
 /// 32-bit multiplies each, below `2^94`); each is divided by the doubled area with its top 32 bits (`2^-31`) and one
-/// 32-bit reciprocal of the area's top 32 bits ([`fresh61`]: `2^-27.6`, the area's truncation `2^-31`), kept to 32
+/// 32-bit reciprocal of the area's top 32 bits ([`crate::fast::fresh61`]: `2^-27.6`, the area's truncation `2^-31`), kept to 32
 /// bits (`2^-28`): below `2^-26.5` relative; then times `r` exactly, truncated (one unit). Accepted when
 /// `|c_k|`'s bound is at most `T_min / 2^9` for every `k` (a plane gentle over the snap's 1/512 px), so the corrected
 /// values err by below `T_min 2^-35`, far inside both fast set-ups' margins; `None` otherwise (the exact solve then
