@@ -17,7 +17,7 @@ pub enum Error {
     DepthRange,
     /// `W_near <= 0`, `W_far <= W_near`, or `W_far / W_near` above [`crate::MAX_T`].
     InvalidDepthRange,
-    /// A depth buffer whose storage does not match its width and height.
+    /// A buffer (depth, packed depth or colour band) whose storage does not match its width and height, or a zero size.
     BufferSize {
         /// Elements the width and height need.
         expected: usize,
@@ -40,6 +40,23 @@ pub enum Error {
     WorldTooLarge,
     /// A mesh index at or beyond the number of vertices, or a per-face colour slice shorter than the faces.
     IndexOutOfRange,
+}
+
+impl Error {
+    /// The buffers' constructors' check: `Err(BufferSize)` unless `actual` is `width * height * per_pixel` elements
+    /// and neither size is 0.
+    pub(crate) fn check_size(
+        actual: usize,
+        width: u16,
+        height: u16,
+        per_pixel: usize,
+    ) -> Result<(), Error> {
+        let expected = width as usize * height as usize * per_pixel;
+        if actual != expected || width == 0 || height == 0 {
+            return Err(Error::BufferSize { expected, actual });
+        }
+        Ok(())
+    }
 }
 
 impl fmt::Display for Error {

@@ -132,6 +132,7 @@ impl DepthRange {
     /// rounding just below zero (a vertex `t` that rounds to 0, `W` beyond `2^61 W_far`) wraps to a `u64` above
     /// `i64::MAX`, which the range test must refuse. (A fuzz finding: with `2^frac W_far / W_near` above `2^64` the
     /// bound saturated at `u64::MAX` and let such a span into the fast loop, whose shift overflowed.)
+    ///
     /// In 64-bit pieces (a variable `u128` shift is a long sequence on the 32-bit cores): `t_max_q < 2^95`
     /// (`far / near <= 2^30` with 64 fraction bits), so its high part `hi = t_max_q >> 32` is below `2^63`, and
     /// `t_max_q / 2^s = hi 2^(32 - s) + floor(lo / 2^s)` for `s < 32`, at least `2^63` exactly when `hi >= 2^(31 + s)`;
