@@ -53,7 +53,13 @@ impl<'a> DepthBuffer<'a> {
 
     /// A band of `height` rows starting at frame row `y0`; `data.len()` must be `width * height`.
     pub fn band(data: &'a mut [u16], width: u16, y0: i32, height: u16) -> Result<Self, Error> {
-        Error::check_size(data.len(), width, height, 1)?;
+        let expected = width as usize * height as usize;
+        if data.len() != expected || width == 0 || height == 0 {
+            return Err(Error::BufferSize {
+                expected,
+                actual: data.len(),
+            });
+        }
         Ok(DepthBuffer {
             data,
             width,

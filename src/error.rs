@@ -42,23 +42,6 @@ pub enum Error {
     IndexOutOfRange,
 }
 
-impl Error {
-    /// The buffers' constructors' check: `Err(BufferSize)` unless `actual` is `width * height * per_pixel` elements
-    /// and neither size is 0.
-    pub(crate) fn check_size(
-        actual: usize,
-        width: u16,
-        height: u16,
-        per_pixel: usize,
-    ) -> Result<(), Error> {
-        let expected = width as usize * height as usize * per_pixel;
-        if actual != expected || width == 0 || height == 0 {
-            return Err(Error::BufferSize { expected, actual });
-        }
-        Ok(())
-    }
-}
-
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

@@ -272,7 +272,13 @@ impl<'a, F: Codec> Packed<'a, F> {
     }
     /// A band of `height` rows from frame row `y0`; `data.len()` must be `width * height * F::BYTES`.
     pub fn band(data: &'a mut [u8], width: u16, y0: i32, height: u16) -> Result<Self, Error> {
-        Error::check_size(data.len(), width, height, F::BYTES)?;
+        let expected = width as usize * height as usize * F::BYTES;
+        if data.len() != expected || width == 0 || height == 0 {
+            return Err(Error::BufferSize {
+                expected,
+                actual: data.len(),
+            });
+        }
         Ok(Packed {
             data,
             width,

@@ -447,8 +447,8 @@ impl Walk {
         // by adding the width (no multiply and no overflow checks per row) where the core has the registers for it
         // (measured: 1.2% fewer instructions on the M4's W3, 3.3% more on the M0's, which takes the row by index).
         let mut base = (j0 - depth_y0) as usize * width as usize;
-        // One row: its run, depth loop and colour (`sr` and `base` at the row), then the step to the next; a macro, so
-        // that each stretch's loop below has it inline.
+        // One row: its run, depth loop and colour (`sr` and `base` at the row); a macro, so that each stretch's loop
+        // below has it inline.
         macro_rules! row {
             ($j:expr, $run:expr) => {
                 'row: {
@@ -494,9 +494,6 @@ impl Walk {
                     stats.fragments += n;
                     stats.written += emit(target, lo, j, n, pass, color)?;
                 }
-                runs.step();
-                sr = sr.wrapping_add(sy);
-                base += width as usize;
             };
         }
         // Rows in two stretches where the runs change edges between them ([`Runs::second`]): each loop then carries
@@ -504,11 +501,17 @@ impl Walk {
         let mid = runs.second_from().min(j1 + 1);
         for j in j0..mid {
             row!(j, runs.run(ox));
+            runs.step();
+            sr = sr.wrapping_add(sy);
+            base += width as usize;
         }
         if mid <= j1 {
             runs.second();
             for j in mid..=j1 {
                 row!(j, runs.run(ox));
+                runs.step();
+                sr = sr.wrapping_add(sy);
+                base += width as usize;
             }
         }
         Ok(stats)

@@ -60,7 +60,13 @@ where
     /// A band of `height` rows from frame row `y0`; `px.len()` must be `width * height` (else
     /// [`Error::BufferSize`], as for zero sizes).
     pub fn band(px: &'a mut [Raw<C>], width: u16, y0: i32, height: u16) -> Result<Self, Error> {
-        Error::check_size(px.len(), width, height, 1)?;
+        let expected = width as usize * height as usize;
+        if px.len() != expected || width == 0 || height == 0 {
+            return Err(Error::BufferSize {
+                expected,
+                actual: px.len(),
+            });
+        }
         Ok(ColorBand {
             px,
             width: width as usize,
