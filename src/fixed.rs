@@ -29,15 +29,15 @@ pub(crate) fn round_shift(m: u64, e: i32) -> u64 {
         if e >= 64 - crate::fast::bits64(m) as i32 {
             return i64::MAX as u64;
         }
-        m << e
+        crate::fast::shl64(m, e as u32)
     } else {
         let s = (-e) as u32;
         if s > 63 {
             return 0;
         }
-        let q = m >> s;
-        let rem = m & ((1u64 << s) - 1);
-        let half = 1u64 << (s - 1);
+        let q = crate::fast::shr64(m, s);
+        let rem = m & (crate::fast::shl64(1, s) - 1);
+        let half = crate::fast::shl64(1, s - 1);
         if rem > half || (rem == half && q & 1 == 1) {
             q + 1
         } else {

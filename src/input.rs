@@ -173,8 +173,8 @@ impl<C: Copy> VertexInput for Vertex<C> {
     #[inline]
     fn depth_xy(&self, bits: u32, ox: i32, oy: i32) -> (i32, i32) {
         (
-            (depth_grid(self.x, bits) - ((ox as i64) << bits)) as i32,
-            (depth_grid(self.y, bits) - ((oy as i64) << bits)) as i32,
+            (depth_grid(self.x, bits) - crate::fast::shl64(ox as i64 as u64, bits) as i64) as i32,
+            (depth_grid(self.y, bits) - crate::fast::shl64(oy as i64 as u64, bits) as i64) as i32,
         )
     }
     #[inline]

@@ -832,7 +832,7 @@ fn t_at_snapped_narrow(s: &Setup) -> Narrow {
 /// [`t_at_snapped_narrow`] cannot vouch for (slivers, steep planes). Out of line: one copy for both (flash).
 #[inline(never)]
 fn t_at_snapped_wide(s: &Setup) -> Option<[i64; 3]> {
-    use crate::fast::{bits64, fresh61, mul_wide, smul_wide, Chord};
+    use crate::fast::{bits64, fresh61, mul_wide, shl64, shr64, smul_wide, Chord};
     let (p, q, t) = (s.p, s.q, s.t);
     // `a b` exactly for `|a| < 2^63`, `|b| < 2^31`, as (sign, magnitude): two 32 x 32 -> 64 products.
     #[inline(always)]
@@ -865,9 +865,9 @@ fn t_at_snapped_wide(s: &Setup) -> Option<[i64; 3]> {
         };
         let b = bits64(w) as i32;
         let n = if b <= 32 {
-            w << (32 - b)
+            shl64(w, (32 - b) as u32)
         } else {
-            w >> (b - 32)
+            shr64(w, (b - 32) as u32)
         };
         (n as u32, b - 32 + extra)
     }
@@ -882,7 +882,7 @@ fn t_at_snapped_wide(s: &Setup) -> Option<[i64; 3]> {
     }
     let a = area.unsigned_abs();
     let la = 64 - bits64(a);
-    let m = ((a << la) >> 32) as u32; // in [2^31, 2^32): a = m 2^(32 - la), truncated
+    let m = (shl64(a, la) >> 32) as u32; // in [2^31, 2^32): a = m 2^(32 - la), truncated
     let x = fresh61::<Chord>(m) as u32; // about 2^61 / m (set-up: one seed for every strategy)
                                         // The gradient's numerators `g = (d1 e2y - d2 e1y, d2 e1x - d1 e2x)`, exact (below 2^94), each divided by the
                                         // area as `gh x 2^(sg + la - 93)` (`gh x` below 2^62), kept as its top 32 bits `G` and exponent `sg + la - 61`.
@@ -911,9 +911,9 @@ fn t_at_snapped_wide(s: &Setup) -> Option<[i64; 3]> {
             if e >= 10 || v >> (62 - e) != 0 {
                 return None; // a term of 2^62 or more
             }
-            v << e
+            shl64(v, e as u32)
         } else {
-            v >> ((-e) as u32).min(63)
+            shr64(v, ((-e) as u32).min(63))
         };
         Some((
             if neg != (r < 0) {

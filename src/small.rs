@@ -58,7 +58,9 @@ use crate::depth::DepthBuffer;
 use crate::edge::{flat_rows, Edge, Fixed, Side, Sub};
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
-use crate::fast::{bits64 as bits, fresh61, lz_small, mul_hi, mul_wide, FreshSeed};
+use crate::fast::{
+    bits64 as bits, fresh61, lz_small, mul_hi, mul_wide, shl64, shr64, wmul, FreshSeed,
+};
 use crate::raster::{rows_of, Setup, Stats, SUBPIXEL_BITS};
 use crate::state::{Cull, RenderState};
 use crate::Error;
@@ -153,14 +155,14 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
     let k = mul_wide(65535, area2 as u32); // area2 < 2^29 (box under 32 x 126 px)
     let kb = bits(k) as i32;
     let (kn, kz) = if kb > 32 {
-        let r = (k + (1 << (kb - 33))) >> (kb - 32);
+        let r = shr64(k + shl64(1, (kb - 33) as u32), (kb - 32) as u32);
         if r >> 32 != 0 {
             (r >> 1, kb - 31)
         } else {
             (r, kb - 32)
         }
     } else {
-        (k << (32 - kb), kb - 32)
+        (shl64(k, (32 - kb) as u32), kb - 32)
     };
     let s0 = 86 - kz - s.frac as i32 - sh as i32; // the code's shift is s0 - lz, lz >= 1
     if s0 > 32 {
@@ -195,14 +197,16 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
         let er = ea * (128 - a.0) + eb * (cy - a.1); // |E| < 2^28 (module doc)
         let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0))); // 0 on a top or left edge
         (scan.e[k], scan.ex[k], scan.ey[k]) = (er - bias, ea << SUBPIXEL_BITS, eb << SUBPIXEL_BITS);
-        sr = sr.wrapping_add((er as i64).wrapping_mul(w[k] as i64) as u64);
-        sx = sx.wrapping_add((scan.ex[k] as i64).wrapping_mul(w[k] as i64) as u64);
-        sy = sy.wrapping_add((scan.ey[k] as i64).wrapping_mul(w[k] as i64) as u64);
+        // The products modulo 2^64 (the walk wraps), without a library call on the Cortex-M0 ([`wmul`]).
+        sr = sr.wrapping_add(wmul(er, w[k]));
+        sx = sx.wrapping_add(wmul(scan.ex[k], w[k]));
+        sy = sy.wrapping_add(wmul(scan.ey[k], w[k]));
     }
     // Every covered pixel's `S 2^sh` lies between its values at the smallest and the largest vertex `T'` (a convex
     // combination): where those two have the same leading zeros, so has every pixel, and the loop takes them once.
     let tp_min = tp[0].min(tp[1]).min(tp[2]);
-    let lz_of = |t: u64| lz_small(((area2 * t) << sh >> 32) as u32);
+    // `2A T'` below 2^63 (`bits(2A) + bits(T'_max) <= 63`), so the wrapping product is exact; `2A < 2^29`.
+    let lz_of = |t: u64| lz_small((shl64(wmul(area2 as i32, t), sh) >> 32) as u32);
     let lz = lz_of(tp_max);
     let same = lz_of(tp_min) == lz;
     // Where the leading zeros are the same, `S` is walked pre-shifted by them too ([`Walk::rows`]), in the same
@@ -212,9 +216,9 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
         j0,
         j1,
         ox,
-        sr: sr << shift,
-        sx: sx << shift,
-        sy: sy << shift,
+        sr: shl64(sr, shift),
+        sx: shl64(sx, shift),
+        sy: shl64(sy, shift),
         kn,
         s0,
         lz: same.then_some(lz),

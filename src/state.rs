@@ -140,12 +140,14 @@ impl DepthRange {
     pub(crate) fn t_max(&self, frac: u32) -> u64 {
         let (hi, lo) = ((self.t_max_q >> 32) as u64, self.t_max_q as u32);
         let s = TMAX_FRAC - frac.min(TMAX_FRAC); // 0..=64
+                                                 // Variable shifts in 32-bit pieces on the Cortex-M0 (`crate::fast::shl64`).
+        use crate::fast::{shl64, shr64};
         if s >= 32 {
-            hi >> (s - 32)
-        } else if hi >> (31 + s) != 0 {
+            shr64(hi, s - 32)
+        } else if shr64(hi, 31 + s) != 0 {
             i64::MAX as u64
         } else {
-            (hi << (32 - s)) | (lo >> s) as u64
+            shl64(hi, 32 - s) | (lo >> s) as u64
         }
     }
 }
