@@ -595,7 +595,7 @@ pub(crate) fn lz_small(h: u32) -> u32 {
 
 /// The bits of `v` (`64 - leading_zeros`, 0 for 0), for set-up code. ARMv6-M (Cortex-M0) and RV32IMAC have no
 /// count-leading-zeros instruction: `leading_zeros` is a library call there (`__clzsi2`, about 35 instructions, two of
-/// them for a `u64`), so they take a six-step binary search inline (tested against `leading_zeros`).
+/// them for a `u64`), so they take [`bits_search`] inline (tested against `leading_zeros`).
 #[inline(always)]
 pub(crate) fn bits64(v: u64) -> u32 {
     if NO_CLZ {
@@ -616,9 +616,8 @@ static BITS8: [u8; 256] = {
     t
 };
 
-/// Three compares narrow `v` to a byte, whose bits a table gives: about 11 instructions fewer a call on the
-/// Cortex-M0 than the six-step search it replaces (whose last three steps the table does), and the M0's set-up
-/// calls it some twenty times a triangle.
+/// Three compares narrow `v` to a byte, whose bits a table gives (the last three steps of a six-step binary search,
+/// which the M0's set-up would otherwise run many times a triangle).
 #[inline(always)]
 fn bits_search(v: u64) -> u32 {
     let (mut x, mut n) = if v >> 32 != 0 {
