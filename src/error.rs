@@ -17,9 +17,11 @@ pub enum Error {
     DepthRange,
     /// `W_near <= 0`, `W_far <= W_near`, or `W_far / W_near` above [`crate::MAX_T`].
     InvalidDepthRange,
-    /// A buffer (depth, packed depth or colour band) whose storage does not match its width and height, or a zero size.
+    /// A buffer whose length does not fit its use: a depth buffer's, packed depth buffer's or colour band's storage
+    /// that does not match its width and height (or a zero size), or a mesh frame's vertex scratch or row bins shorter
+    /// than the mesh ([`crate::Rasterizer::transform_mesh`], [`crate::Rasterizer::bin_mesh`]).
     BufferSize {
-        /// Elements the width and height need.
+        /// Elements needed: what the width and height make, or the least length the mesh needs.
         expected: usize,
         /// Elements given.
         actual: usize,
@@ -57,10 +59,7 @@ impl fmt::Display for Error {
                 f.write_str("depth range needs 0 < W_near < W_far and W_far/W_near <= 2^30")
             }
             Error::BufferSize { expected, actual } => {
-                write!(
-                    f,
-                    "depth buffer has {actual} elements, width x height needs {expected}"
-                )
+                write!(f, "buffer has {actual} elements, {expected} needed")
             }
             Error::Target => f.write_str("the draw target returned an error"),
             Error::ZWithWFormat => {

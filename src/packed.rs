@@ -497,6 +497,7 @@ impl<R: WSpan> Rasterizer<R> {
     }
     #[cfg(not(feature = "bias"))]
     #[inline(always)]
+    #[allow(clippy::extra_unused_type_parameters)] // the bias build's signature, so that callers need no `cfg`
     fn format_bias<F: Codec>(
         &self,
         _: &ZConst,
