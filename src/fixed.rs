@@ -16,9 +16,10 @@ pub(crate) fn split(v: f32) -> Option<(bool, u32, i32)> {
     }
 }
 
-/// `round(m * 2^e)` for any `m` (an f32 mantissa times the far plane's, or a 32-bit fixed-point `1/W` times it:
+/// `round(m * 2^e)` (`m` an f32 mantissa times the far plane's, or a 32-bit fixed-point `1/W` times it, below `2^56`:
 /// not normalised, so a small `m` may take a large `e`), ties to even, saturating at `i64::MAX` (callers
-/// range-check the input first).
+/// range-check the input first). Exact for any `m` down to `e = -63`, and below that for `m <= 2^63`, which then
+/// rounds to 0 (tested against `u128`).
 #[inline]
 pub(crate) fn round_shift(m: u64, e: i32) -> u64 {
     if m == 0 {
@@ -285,6 +286,44 @@ mod tests {
         assert_eq!(round_shift(u64::MAX >> 1, 0), u64::MAX >> 1);
         assert_eq!(round_shift(5, -1), 2); // 2.5 ties to even
         assert_eq!(round_shift(7, -1), 4); // 3.5 ties to even
+    }
+
+    /// `round_shift` against the exact value in `u128`, ties to even: every `m` for shifts down to `2^-63`, and the
+    /// `m <= 2^63` below that (where `m 2^e <= 1/2` rounds to 0); up, exact below `2^63` and saturated from there.
+    #[test]
+    fn round_shift_is_the_rounded_product() {
+        let exact = |m: u64, e: i32| -> u64 {
+            if e >= 0 {
+                let v = (m as u128) << e.min(64);
+                return if v >= 1 << 63 {
+                    i64::MAX as u64
+                } else {
+                    v as u64
+                };
+            }
+            let s = (-e) as u32;
+            let (q, rem) = ((m as u128) >> s.min(127), (m as u128) & ((1u128 << s) - 1));
+            let half = 1u128 << (s - 1);
+            (q + u128::from(rem > half || (rem == half && q & 1 == 1))) as u64
+        };
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        for k in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let m = x >> (k % 64);
+            for e in -63..=64 {
+                assert_eq!(round_shift(m, e), exact(m, e), "{m} {e}");
+            }
+            for e in -80..-63 {
+                let m = m >> 1; // below 2^63
+                assert_eq!(round_shift(m, e), exact(m, e), "{m} {e}");
+            }
+        }
+        // The half-way points at the deepest shifts that keep every `m`.
+        assert_eq!(round_shift(1 << 62, -63), 0); // 1/2, ties to even
+        assert_eq!(round_shift((1 << 62) + 1, -63), 1);
+        assert_eq!(round_shift(u64::MAX, -63), 2);
     }
 
     #[test]
