@@ -711,16 +711,11 @@ fn sar_to_i32(v: i64, s: u32) -> i32 {
     }
 }
 
-/// `floor(v / 2^s)` for any `s` (0 from 64 on), from 32-bit shifts.
+/// `floor(v / 2^s)` for any `s` (0 from 64 on), from 32-bit shifts ([`crate::fast::shr_pieces`]).
 #[inline(always)]
 fn shr_u64(v: u64, s: u32) -> u64 {
-    let (hi, lo) = ((v >> 32) as u32, v as u32);
-    if s == 0 {
-        v
-    } else if s < 32 {
-        (((hi >> s) as u64) << 32) | ((hi << (32 - s)) | (lo >> s)) as u64
-    } else if s < 64 {
-        (hi >> (s - 32)) as u64
+    if s < 64 {
+        crate::fast::shr_pieces(v, s)
     } else {
         0
     }
