@@ -52,7 +52,7 @@ fn snap(v: f32) -> Result<i32, Error> {
 /// rounds with two additions instead of integer operations on the bits. The same results either way (both are
 /// round-to-nearest-even of the same exact product; a unit test compares them), so frames stay bit-identical across
 /// cores. An ARM target with the hard-float ABI has an FPU; the Cortex-M0 and RV32IMAC have none.
-const HARD_FLOAT: bool = cfg!(any(
+pub(crate) const HARD_FLOAT: bool = cfg!(any(
     target_abi = "eabihf",
     target_arch = "x86_64",
     target_arch = "aarch64",
@@ -77,6 +77,39 @@ fn snap_exact(v: f32) -> Result<(i32, bool), Error> {
         return Err(Error::OutOfGuardBand);
     }
     Ok(snap_fpu(v))
+}
+
+/// The doubled signed area of the triangle `v` (screen `(x, y)`, y down; positive is clockwise on the display) after
+/// snapping, in units of `2^-16` px², exactly: the area whose sign the rasterizer culls by. `None` where a coordinate
+/// does not snap (NaN, infinite, or beyond the guard band). Snapped coordinates are below `2^20` units, so their
+/// differences are below `2^21` and each product below `2^42` ([`crate::fast::smul_wide`]: no `__aeabi_lmul` call on
+/// the Cortex-M0).
+#[inline(never)] // the rare fallback of the culls' filters: one copy
+pub(crate) fn snapped_area(v: [(f32, f32); 3]) -> Option<i64> {
+    let mut p = [(0i32, 0i32); 3];
+    for (q, &(x, y)) in p.iter_mut().zip(v.iter()) {
+        *q = (snap_exact(x).ok()?.0, snap_exact(y).ok()?.0);
+    }
+    let (ux, uy) = (p[1].0 - p[0].0, p[1].1 - p[0].1);
+    let (vx, vy) = (p[2].0 - p[0].0, p[2].1 - p[0].1);
+    Some(crate::fast::smul_wide(ux, vy) - crate::fast::smul_wide(vx, uy))
+}
+
+/// `v * 256` truncated toward zero, from the bits, for a finite `|v| < 2^12` (a cheaper neighbour of the snap for
+/// filters: within one unit of it, or of `v * 256`).
+#[inline(always)]
+pub(crate) fn fixed_trunc(v: f32) -> i32 {
+    let b = v.to_bits();
+    let mag = b & 0x7fff_ffff;
+    let s = 142i32 - (mag >> 23) as i32; // v * 256 = m 2^-s, s >= 4 below 2^12
+    let m = (mag & 0x7f_ffff) | 0x80_0000;
+    // s >= 24: below 1 (zero and subnormals too); `s < 4` (outside the domain) shifts by 0, a value but no panic.
+    let r = if s >= 24 { 0 } else { (m >> s.max(0)) as i32 };
+    if b >> 31 != 0 {
+        -r
+    } else {
+        r
+    }
 }
 
 /// [`snap_exact`]'s FPU rounding, for a finite `|v| < 2^12`.
@@ -360,6 +393,24 @@ mod tests {
             f32::NEG_INFINITY,
         ] {
             check(v);
+        }
+    }
+
+    /// `fixed_trunc` is `v * 256` truncated toward zero on its domain (finite, `|v| < 2^12`): every bit class there,
+    /// and every sub-pixel boundary and its neighbours.
+    #[test]
+    fn fixed_trunc_truncates() {
+        let check = |v: f32| {
+            if v.is_finite() && v.abs() < 4096.0 {
+                assert_eq!(fixed_trunc(v), (v as f64 * 256.0).trunc() as i32, "{v:e}");
+            }
+        };
+        each_bit_class(1_000_000, 0x1234_5678, check);
+        for k in -(1i32 << 20)..(1 << 20) {
+            let t = k as f32 / 256.0;
+            check(t);
+            check(f32::from_bits(t.to_bits() + 1));
+            check(f32::from_bits(t.to_bits().wrapping_sub(1)));
         }
     }
 

@@ -4,7 +4,9 @@
 //! allocation): screen `x`, `y` and `rhw` for a vertex in front of the near plane and inside the guard band, a mark
 //! for the others. [`Rasterizer::draw_mesh_frame`] then draws the triangles into a buffer or a band of one, as often
 //! as there are bands: a triangle whose three vertices are marked inside is tested against the band's rows (a band
-//! it cannot touch costs a compare), culled by the sign of its screen area, and drawn; the few others are transformed
+//! it cannot touch costs a compare), culled by the sign of its snapped screen area (the rasterizer's own test, so the
+//! mesh drops exactly the triangles a draw of them would; a float or integer filter decides without snapping unless
+//! the area is near zero), and drawn; the few others are transformed
 //! again from their positions, rejected when all three vertices lie outside one plane, culled by the sign of
 //! `det[x y w]` (the homogeneous back-face test, right for vertices behind the eye too) and clipped
 //! ([`crate::clip`]). [`Rasterizer::bin_mesh`], once per frame, culls the triangles on screen and records each one's
@@ -160,7 +162,7 @@ impl Bins<'_> {
     /// (Without the `- 1`, a negative `ymin` rounded up misses bands above row 0.)
     #[inline]
     fn rows(ymin: f32, ymax: f32) -> (i32, i32) {
-        (ymin as i32 - 1, ymax as i32)
+        (trunc(ymin) - 1, trunc(ymax))
     }
     #[inline]
     fn bucket(&self, row: i32) -> u8 {
@@ -266,7 +268,7 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
                 return Ok(());
             }
             let vc = self.colors(k, idx);
-            if !binned && culled(cull, screen_area(&a, &b, &c)) {
+            if !binned && culled_on_screen(cull, &[a, b, c]) {
                 stats.culled += 1;
                 return Ok(());
             }
@@ -320,10 +322,109 @@ fn screen_tri<C>(frame: &MeshFrame<'_, C>, k: usize) -> [Projected; 3] {
     frame.mesh.indices[k].map(|i| frame.verts[i as usize])
 }
 
-/// The screen area of a triangle (doubled; y down: positive is clockwise on the display).
-#[inline]
+/// The screen area of a triangle (doubled; y down: positive is clockwise on the display), in f32.
+#[cfg(test)]
 fn screen_area(a: &Projected, b: &Projected, c: &Projected) -> f32 {
     (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y)
+}
+
+/// Whether a triangle on screen is culled as `cull` says: by the sign of the doubled area of its snapped vertices
+/// ([`crate::input::snapped_area`]), the test the rasterizer applies to every triangle it is given, so that culling
+/// here (once a frame, before the set-up) drops exactly the triangles the draws would drop (a zero area among them:
+/// it covers no pixel). Where the core has an FPU the float area decides first when it is far enough from zero
+/// ([`clear_area`]); otherwise, and on cores without an FPU (where each float operation is a library call of some 60
+/// to 90 instructions), the snapped area itself. The same triangles either way, on every core.
+#[inline]
+fn culled_on_screen(cull: Cull, v: &[Projected; 3]) -> bool {
+    let area = if crate::input::HARD_FLOAT {
+        if let Some(area) = clear_area(v) {
+            return culled(cull, area);
+        }
+        None
+    } else {
+        clear_area_fixed(v)
+    };
+    let [a, b, c] = v;
+    match area.or_else(|| crate::input::snapped_area([(a.x, a.y), (b.x, b.y), (c.x, c.y)])) {
+        Some(area) => match cull {
+            _ if area == 0 => true,
+            Cull::Cw => area > 0,
+            Cull::Ccw => area < 0,
+            Cull::None => false,
+        },
+        // Not reached for vertices `transform_mesh` put on screen (finite, inside the clip band, which is inside the
+        // guard band): the draw reports it.
+        None => false,
+    }
+}
+
+/// [`culled_on_screen`]'s float test: the f32 doubled area where it is far enough from zero that the snapped area
+/// has its sign (nonzero), else `None`. With `u = b - a`, `v = c - a` and `S = |ux| + |uy| + |vx| + |vy|`:
+/// snapping moves each coordinate by at most `2^-9` px, each difference by `2^-8`, so the snapped area is within
+/// `2^-8 S + 2^-15` of the exact area of the vertices as given (the cross terms, and the product of two moves twice).
+/// The f32 evaluation (three roundings on each product's path, one on the difference) is within
+/// `4.01 2^-24 (|ux vy| + |vx uy|)` of that, and on screen every coordinate is within the clip band (`|x| <= 4000`),
+/// so each difference is at most 8000 and `|ux vy| + |vx uy| <= 8000 S`: within `2^-8.9 S`. Both together are below
+/// `2^-7 S + 2^-14`, with room for the rounding of `S` itself (relative `2^-22`) and any underflow (`2^-149`).
+#[inline]
+fn clear_area([a, b, c]: &[Projected; 3]) -> Option<f32> {
+    let (ux, uy, vx, vy) = (b.x - a.x, b.y - a.y, c.x - a.x, c.y - a.y);
+    let area = ux * vy - vx * uy;
+    (area.abs() > (ux.abs() + uy.abs() + vx.abs() + vy.abs()) * (1.0 / 128.0) + 1.0 / 16384.0)
+        .then_some(area)
+}
+
+/// [`clear_area`] for cores without an FPU, in integers: the doubled area `At` of the vertices truncated to the
+/// snap grid ([`crate::input::fixed_trunc`], units of `2^-8` px, within one unit of `256 x`), where its sign is the
+/// snapped area's, else `None`. With `S` the sum of the four differences' magnitudes (real, in units) and
+/// `St` the truncated ones' (within 8 of `S`): the snapped area is within `S + 2` units² of the exact area times
+/// `2^16` ([`clear_area`]'s argument in units), and `At` within `2 S + 8` (each difference is off by below 2 units).
+/// So where `|At| > 3 St + 34 >= 3 S + 10`, the snapped area has `At`'s sign and is not zero.
+#[inline]
+fn clear_area_fixed([a, b, c]: &[Projected; 3]) -> Option<i64> {
+    use crate::input::fixed_trunc as t;
+    let (ux, uy) = (t(b.x) - t(a.x), t(b.y) - t(a.y));
+    let (vx, vy) = (t(c.x) - t(a.x), t(c.y) - t(a.y));
+    // Coordinates within the clip band (below 2^20 units): differences below 2^21, products below 2^42.
+    let area = crate::fast::smul_wide(ux, vy) - crate::fast::smul_wide(vx, uy);
+    let st = ux.unsigned_abs() + uy.unsigned_abs() + vx.unsigned_abs() + vy.unsigned_abs();
+    (area.unsigned_abs() > 3 * st as u64 + 34).then_some(area)
+}
+
+/// `v as i32` (toward zero, saturating, NaN to 0): the FPU's conversion where the core has one, else from the bits
+/// (where `as i32` is four library calls: the NaN test, two range tests and the conversion).
+#[inline]
+fn trunc(v: f32) -> i32 {
+    if crate::input::HARD_FLOAT {
+        v as i32
+    } else {
+        trunc_bits(v)
+    }
+}
+
+/// [`trunc`] from the bits.
+#[inline]
+fn trunc_bits(v: f32) -> i32 {
+    let b = v.to_bits();
+    let mag = b & 0x7fff_ffff;
+    let exp = (mag >> 23) as i32;
+    let r = if mag > 0x7f80_0000 || exp < 127 {
+        0 // NaN, or below 1 in magnitude
+    } else if exp >= 127 + 31 {
+        return if b >> 31 != 0 { i32::MIN } else { i32::MAX };
+    } else {
+        let m = (mag & 0x7f_ffff) | 0x80_0000;
+        (if exp >= 150 {
+            m << (exp - 150)
+        } else {
+            m >> (150 - exp)
+        }) as i32 // below 2^31
+    };
+    if b >> 31 != 0 {
+        -r
+    } else {
+        r
+    }
 }
 
 /// An integer with the order of the (non-NaN) f32 `y`: the bits, with the magnitude flipped for negative values.
@@ -454,7 +555,7 @@ impl<R: WSpan> Rasterizer<R> {
         for (k, b) in of.iter_mut().enumerate() {
             let v = screen_tri(&frame, k);
             *b = if on_screen(&v) {
-                if culled(cull, screen_area(&v[0], &v[1], &v[2])) {
+                if culled_on_screen(cull, &v) {
                     culled_n += 1;
                     CULLED
                 } else {
@@ -839,5 +940,91 @@ mod tests {
         let mut band = crate::DepthBuffer::band(&mut data, 64, 10, 4).unwrap();
         let s = r.draw_mesh_frame(&mut Null, &mut band, &frame).unwrap();
         assert_eq!(s.culled, 1, "{s:?}");
+    }
+
+    /// `trunc_bits` (the cores without an FPU) is `as i32` (the FPU's conversion) on every class of f32: a stride
+    /// through all bit patterns, every integer boundary near the guard band, and the specials.
+    #[test]
+    fn trunc_from_the_bits_is_as_i32() {
+        let check = |v: f32| assert_eq!(trunc_bits(v), v as i32, "{v:e} ({:#x})", v.to_bits());
+        for b in (0..=u32::MAX).step_by(997) {
+            check(f32::from_bits(b));
+        }
+        for k in -5000..5000 {
+            let t = k as f32 * 0.5;
+            for d in [0, 1, 2] {
+                check(f32::from_bits(t.to_bits() + d));
+                check(f32::from_bits(t.to_bits().wrapping_sub(d)));
+            }
+        }
+        for v in [
+            0.0,
+            -0.0,
+            f32::NAN,
+            -f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            2147483520.0,
+            2147483648.0,
+            -2147483648.0,
+            -2147483904.0,
+            f32::MIN_POSITIVE,
+        ] {
+            check(v);
+        }
+    }
+
+    /// Where the float test decides ([`clear_area`]), or the integer one ([`clear_area_fixed`]), the snapped area has its sign: on random triangles and on
+    /// near-degenerate ones (a third vertex a few ulps off the line through two others, and tiny triangles), whose
+    /// float and snapped areas often disagree, so the fallback is needed (asserted) and the bound is what decides.
+    #[test]
+    fn the_float_cull_has_the_snapped_areas_sign() {
+        let mut rnd = crate::xorshift(0x5EED_CAFE_0001);
+        let mut unit = move || (rnd() >> 40) as f32 / (1u64 << 24) as f32;
+        let (mut decided, mut fallback, mut disagree, mut fixed) = (0, 0, 0, 0);
+        for n in 0..400_000 {
+            let mut pt = |scale: f32| (unit() * scale - scale / 2.0, unit() * scale - scale / 2.0);
+            let scale = [4000.0, 200.0, 4.0, 0.05][n % 4]; // c stays below 4000 (the clip band)
+            let (a, b) = (pt(scale), pt(scale));
+            let c = if n % 3 == 0 {
+                // On the line through a and b, then a few ulps off it.
+                let t = unit() * 2.0 - 0.5;
+                let (x, y) = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+                let k = (unit() * 8.0) as u32;
+                (f32::from_bits(x.to_bits() + k), y)
+            } else {
+                pt(scale)
+            };
+            let v = [a, b, c].map(|(x, y)| Projected { x, y, rhw: 1.0 });
+            let snapped = crate::input::snapped_area([a, b, c]).unwrap();
+            if let Some(area) = clear_area_fixed(&v) {
+                fixed += 1;
+                assert!(
+                    area != 0 && (area > 0) == (snapped > 0),
+                    "{a:?} {b:?} {c:?}: {area} {snapped}"
+                );
+            }
+            let float = (b.0 - a.0) * (c.1 - a.1) - (c.0 - a.0) * (b.1 - a.1);
+            match clear_area(&v) {
+                Some(area) => {
+                    decided += 1;
+                    assert!(
+                        (area > 0.0 && snapped > 0) || (area < 0.0 && snapped < 0),
+                        "{a:?} {b:?} {c:?}: float {area:e}, snapped {snapped}"
+                    );
+                }
+                None => {
+                    fallback += 1;
+                    if (float > 0.0) != (snapped > 0) || (float == 0.0) != (snapped == 0) {
+                        disagree += 1;
+                    }
+                }
+            }
+        }
+        assert!(
+            decided > 200_000 && fallback > 10_000 && disagree > 1_000,
+            "{decided} {fallback} {disagree}"
+        );
+        assert!(fixed > 150_000, "{fixed}");
     }
 }

@@ -152,7 +152,10 @@ impl IntTransform {
             )
         };
         let (x, y) = (screen(&self.rows[0]), screen(&self.rows[1]));
-        if !(x.abs() <= CLIP_BAND && y.abs() <= CLIP_BAND) {
+        // `|x| <= CLIP_BAND` on the bits (a float compare is a library call on a core without an FPU): the
+        // magnitudes of non-negative floats order as their bits, and a NaN's lie above every finite one's.
+        let within = |v: f32| v.to_bits() & 0x7fff_ffff <= CLIP_BAND.to_bits();
+        if !(within(x) && within(y)) {
             return Ok(None);
         }
         Ok(Some(Projected { x, y, rhw }))
