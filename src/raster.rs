@@ -54,6 +54,13 @@ pub const SUBPIXEL_BITS: u32 = 8;
 pub const fn depth_grid_bits(extent: i32) -> u32 {
     31 - (32 - ((extent + 2) as u32).leading_zeros())
 }
+
+/// [`depth_grid_bits`] for the set-up, for `extent` in `0..=8192`: the same value (tested), with the crate's bit count
+/// ([`crate::fast::bits64`]) instead of `leading_zeros`, a library call on the cores without `CLZ`.
+#[inline(always)]
+fn grid_bits(extent: i32) -> u32 {
+    31 - crate::fast::bits64((extent + 2) as u32 as u64)
+}
 /// Vertices must have `|x|, |y| < GUARD_BAND` pixels (see ARCHITECTURE.md for why this is safe in i64).
 pub const GUARD_BAND: i32 = 4096;
 
@@ -210,7 +217,7 @@ impl<R: WSpan> Rasterizer<R> {
             );
             let xe = (p.iter().map(|s| s.x).max().unwrap_or(0) >> SUBPIXEL_BITS) - ox;
             let ye = (p.iter().map(|s| s.y).max().unwrap_or(0) >> SUBPIXEL_BITS) - oy;
-            dbits = depth_grid_bits(xe.max(ye));
+            dbits = grid_bits(xe.max(ye));
             dorigin = (ox, oy);
             for k in 0..N {
                 let (x, y) = v[k].depth_xy(dbits, ox, oy);
@@ -1582,11 +1589,13 @@ mod tests {
 
     /// The depth grid's fraction bits are the finest that keep a box's positions in 31 bits: `(extent + 2) 2^bits`
     /// below `2^31`, and one bit more would reach it, for every extent up to the guard band's 8192 px; the
-    /// documented values: 29 within one pixel, 24 under 126 px, 17 for the largest boxes.
+    /// documented values: 29 within one pixel, 24 under 126 px, 17 for the largest boxes. The set-up's `grid_bits` is
+    /// the same.
     #[test]
     fn depth_grid_bits_is_the_finest_in_31_bits() {
         for e in 0..=8192i32 {
             let b = depth_grid_bits(e);
+            assert_eq!(grid_bits(e), b);
             let span = (e as u64 + 2) << b;
             assert!(
                 span < 1 << 31 && span << 1 >= 1 << 31,

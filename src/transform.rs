@@ -62,7 +62,7 @@ fn scaled(v: f32, s: i32) -> i64 {
 /// The exponent `b` with `|v| < 2^b` for a finite f32 (`i32::MIN` for 0): its mantissa's bits above its exponent.
 fn magnitude(v: f32) -> i32 {
     match split(v) {
-        Some((_, m, e)) if m != 0 => e + (32 - m.leading_zeros() as i32),
+        Some((_, m, e)) if m != 0 => e + bits64(m as u64) as i32, // `bits64`: no `leading_zeros` library call
         _ => i32::MIN,
     }
 }
