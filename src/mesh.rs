@@ -388,7 +388,8 @@ fn clear_area_fixed([a, b, c]: &[Projected; 3]) -> Option<i64> {
     // Coordinates within the clip band (below 2^20 units): differences below 2^21, products below 2^42.
     let area = crate::fast::smul_wide(ux, vy) - crate::fast::smul_wide(vx, uy);
     let st = ux.unsigned_abs() + uy.unsigned_abs() + vx.unsigned_abs() + vy.unsigned_abs();
-    (area.unsigned_abs() > 3 * st as u64 + 34).then_some(area)
+    // `st` below 2^23: `3 st + 34` fits a u32 (a u64 product would be a library call on the Cortex-M0).
+    (area.unsigned_abs() > (3 * st + 34) as u64).then_some(area)
 }
 
 /// `v as i32` (toward zero, saturating, NaN to 0): the FPU's conversion where the core has one, else from the bits

@@ -910,7 +910,7 @@ fn t_at_snapped_wide(s: &Setup) -> Option<[i64; 3]> {
         }
         let v = mul_wide(gm, r.unsigned_abs());
         let v = if e >= 0 {
-            if e >= 10 || v >> (62 - e) != 0 {
+            if e >= 10 || shr64(v, (62 - e) as u32) != 0 {
                 return None; // a term of 2^62 or more
             }
             shl64(v, e as u32)

@@ -143,7 +143,8 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
     let (t_min, t_max) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
     let e = margin(t_max);
     let t_hi = state.range.t_max(s.frac);
-    if t_min < e || t_min - e < 1u64 << s.frac || t_max + e > t_hi || t_min < 1 << 56 {
+    // `2^F` from 32-bit pieces on the Cortex-M0 ([`shl64`]; `F <= 61`), where `1 << F` is a library call.
+    if t_min < e || t_min - e < shl64(1, s.frac) || t_max + e > t_hi || t_min < 1 << 56 {
         return Ok(None);
     }
     let tp = t.map(|v| (v + (1 << 24)) >> 25); // T' = round(T / 2^25) in [2^31, 2^36]
@@ -185,23 +186,25 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
     // top-left bias) at the same centre, for the scan.
     let cy = ((j0 - oy) << SUBPIXEL_BITS) + 128;
     let (mut sr, mut sx, mut sy) = (0u64, 0u64, 0u64);
-    let mut scan = Scan {
-        e: [0; 3],
-        ex: [0; 3],
-        ey: [0; 3],
-        ncol: ((xmax - 128) >> SUBPIXEL_BITS) - ox + 1,
-    };
+    // Three arrays rather than the `Scan` filled in place (a zeroed struct: a `memclr` call on the Cortex-M0).
+    let (mut e, mut ex, mut ey) = ([0i32; 3], [0i32; 3], [0i32; 3]);
     for k in 0..3 {
         let (a, c) = (q[k], q[(k + 1) % 3]);
         let (ea, eb) = (a.1 - c.1, c.0 - a.0);
         let er = ea * (128 - a.0) + eb * (cy - a.1); // |E| < 2^28 (module doc)
         let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0))); // 0 on a top or left edge
-        (scan.e[k], scan.ex[k], scan.ey[k]) = (er - bias, ea << SUBPIXEL_BITS, eb << SUBPIXEL_BITS);
+        (e[k], ex[k], ey[k]) = (er - bias, ea << SUBPIXEL_BITS, eb << SUBPIXEL_BITS);
         // The products modulo 2^64 (the walk wraps), without a library call on the Cortex-M0 ([`wmul`]).
         sr = sr.wrapping_add(wmul(er, w[k]));
-        sx = sx.wrapping_add(wmul(scan.ex[k], w[k]));
-        sy = sy.wrapping_add(wmul(scan.ey[k], w[k]));
+        sx = sx.wrapping_add(wmul(ex[k], w[k]));
+        sy = sy.wrapping_add(wmul(ey[k], w[k]));
     }
+    let scan = Scan {
+        e,
+        ex,
+        ey,
+        ncol: ((xmax - 128) >> SUBPIXEL_BITS) - ox + 1,
+    };
     // Every covered pixel's `S 2^sh` lies between its values at the smallest and the largest vertex `T'` (a convex
     // combination): where those two have the same leading zeros, so has every pixel, and the loop takes them once.
     let tp_min = tp[0].min(tp[1]).min(tp[2]);
@@ -556,7 +559,7 @@ fn emit<D: DrawTarget>(
     }
     // Runs of set bits from the first pixel (bit n - 1) on: shifted to the top of a u64, whose leading zeros and
     // ones are the gap and the run (a u64 so that shifting out all 32 bits is defined).
-    let (mut m, mut at) = ((pass as u64) << (64 - n), 0u32);
+    let (mut m, mut at) = (shl64(pass as u64, 64 - n), 0u32); // 1 <= n <= 32: a shift of 32 to 63
     while m != 0 {
         let skip = m.leading_zeros();
         m <<= skip;
