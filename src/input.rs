@@ -187,7 +187,7 @@ fn snap_packed(v: f32) -> u64 {
 /// `round(v * 2^bits)`, ties to even, for a finite `|v| < GUARD_BAND` (checked by [`snap_exact`] first) and `bits <= 31`:
 /// `v * 2^bits = m 2^(exp - 150 + bits)` with the 24-bit mantissa `m`; a left shift (exact, below `2^43`) where that
 /// exponent is not negative, else a rounded right shift as in [`snap_exact`].
-#[inline(never)]
+#[inline(always)]
 fn depth_grid(v: f32, bits: u32) -> i64 {
     const _: () = assert!(GUARD_BAND == 1 << 12);
     let b = v.to_bits();
@@ -215,6 +215,17 @@ fn depth_grid(v: f32, bits: u32) -> i64 {
     }
 }
 
+/// A vertex's position on the depth grid of `bits` fraction bits ([`depth_grid`]) relative to the pixel `(ox, oy)`:
+/// `x` in the low word, `y` in the high one. Out of line, one call a vertex (flash), its pair in one `u64` (two
+/// registers, where a pair of `i32` is returned through memory on the 32-bit ARM cores).
+#[inline(never)]
+fn depth_pair(x: f32, y: f32, bits: u32, ox: i32, oy: i32) -> u64 {
+    let rel = |v: f32, o: i32| {
+        (depth_grid(v, bits) - crate::fast::shl64(o as i64 as u64, bits) as i64) as i32
+    };
+    rel(x, ox) as u32 as u64 | (rel(y, oy) as u32 as u64) << 32
+}
+
 impl<C> sealed::Sealed for Vertex<C> {}
 impl<C: Copy> VertexInput for Vertex<C> {
     type Color = C;
@@ -229,10 +240,8 @@ impl<C: Copy> VertexInput for Vertex<C> {
     }
     #[inline]
     fn depth_xy(&self, bits: u32, ox: i32, oy: i32) -> (i32, i32) {
-        (
-            (depth_grid(self.x, bits) - crate::fast::shl64(ox as i64 as u64, bits) as i64) as i32,
-            (depth_grid(self.y, bits) - crate::fast::shl64(oy as i64 as u64, bits) as i64) as i32,
-        )
+        let p = depth_pair(self.x, self.y, bits, ox, oy);
+        (p as i32, (p >> 32) as i32)
     }
     #[inline]
     fn rhw_exact(&self) -> Result<(u32, i32), Error> {
