@@ -557,6 +557,49 @@ fn emit<D: DrawTarget>(
         fill_run(target, x0, j, n, color)?;
         return Ok(n);
     }
+    if ROWS_BY_DIVISION {
+        partial_out(target, x0, j, n, pass, color)
+    } else {
+        partial(target, x0, j, n, pass, color)
+    }
+}
+
+/// [`partial`] out of line, so that the row walk keeps its registers for the common case (every pixel passed): where
+/// rows are found by division (measured on the Cortex-M4: 1.6% fewer instructions on W3, 0.7% on W4; on the M0, whose
+/// scan keeps other registers, inline is 0.4% cheaper).
+#[inline(never)]
+fn partial_out<D: DrawTarget>(
+    target: &mut D,
+    x0: i32,
+    j: i32,
+    n: u32,
+    pass: u32,
+    color: D::Color,
+) -> Result<u32, Error> {
+    partial(target, x0, j, n, pass, color)
+}
+
+/// [`emit`] of a run not every pixel of which passed.
+#[inline(always)]
+fn partial<D: DrawTarget>(
+    target: &mut D,
+    x0: i32,
+    j: i32,
+    n: u32,
+    pass: u32,
+    color: D::Color,
+) -> Result<u32, Error> {
+    #[inline(always)]
+    fn fill_run<D: DrawTarget>(
+        t: &mut D,
+        x: i32,
+        j: i32,
+        len: u32,
+        c: D::Color,
+    ) -> Result<(), Error> {
+        let r = Rectangle::new(Point::new(x, j), Size::new(len, 1));
+        t.fill_solid(&r, c).map_err(|_| Error::Target)
+    }
     // Runs of set bits from the first pixel (bit n - 1) on: shifted to the top of a u64, whose leading zeros and
     // ones are the gap and the run (a u64 so that shifting out all 32 bits is defined).
     let (mut m, mut at) = (shl64(pass as u64, 64 - n), 0u32); // 1 <= n <= 32: a shift of 32 to 63
