@@ -1028,4 +1028,83 @@ mod tests {
         );
         assert!(fixed > 150_000, "{fixed}");
     }
+
+    /// The filters' bounds are what decides: triangles built so that snapping shrinks the area as far as it can
+    /// (every coordinate just beside a half-sub-pixel tie, on the side that rounds against the area) have a positive
+    /// area up to about `2^-8 S` whose snapped area is negative. Both filters leave every one of them to the snapped
+    /// area; with either bound at a quarter of its derived size, many would be culled by the wrong sign (counted here,
+    /// so a filter too loose for these triangles fails the test).
+    #[test]
+    fn adversarial_snaps_stay_with_the_snapped_area() {
+        let mut rnd = crate::xorshift(0xAD5E_5A1E_0002);
+        let mut unit = move || (rnd() >> 40) as f32 / (1u64 << 24) as f32;
+        let (mut wrong_sign, mut quarter_float, mut quarter_fixed) = (0, 0, 0);
+        for _ in 0..200_000 {
+            // Within 64 px, where the f32 spacing (2^-18 px) resolves a point 2^-16 px beside a tie.
+            let tie = |v: f32| ((v * 256.0).floor() + 0.5) / 256.0;
+            let (a, b) = (
+                (unit() * 64.0, unit() * 64.0),
+                (unit() * 64.0, unit() * 64.0),
+            );
+            let (ux, uy) = (b.0 - a.0, b.1 - a.1);
+            let len = (ux * ux + uy * uy).sqrt();
+            if len < 1.0 {
+                continue;
+            }
+            // c beside the line through a and b, by a fraction of a sub-pixel.
+            let (t, d) = (unit(), (unit() - 0.25) / 256.0);
+            let c = (a.0 + t * ux - d * uy / len, a.1 + t * uy + d * ux / len);
+            let [a, b, c] = [a, b, c].map(|(x, y)| (tie(x), tie(y)));
+            // dA/d(coordinate), then each coordinate 2^-16 px to the side that snaps against the area.
+            let g = [
+                b.1 - c.1,
+                c.0 - b.0,
+                c.1 - a.1,
+                a.0 - c.0,
+                a.1 - b.1,
+                b.0 - a.0,
+            ];
+            let mut q = [a.0, a.1, b.0, b.1, c.0, c.1];
+            for (v, g) in q.iter_mut().zip(g) {
+                *v += if g > 0.0 { -1.0 } else { 1.0 } / 65536.0;
+            }
+            let [a, b, c] = [(q[0], q[1]), (q[2], q[3]), (q[4], q[5])];
+            let area =
+                (b.0 - a.0) as f64 * (c.1 - a.1) as f64 - (c.0 - a.0) as f64 * (b.1 - a.1) as f64;
+            let snapped = crate::input::snapped_area([a, b, c]).unwrap();
+            if area <= 0.0 || snapped > 0 {
+                continue;
+            }
+            wrong_sign += 1;
+            let v = [a, b, c].map(|(x, y)| Projected { x, y, rhw: 1.0 });
+            assert_eq!(
+                clear_area(&v),
+                None,
+                "{a:?} {b:?} {c:?}: {area:e}, snapped {snapped}"
+            );
+            assert_eq!(
+                clear_area_fixed(&v),
+                None,
+                "{a:?} {b:?} {c:?}: {area:e}, snapped {snapped}"
+            );
+            // What a quarter of each bound would have decided (by the wrong sign).
+            let s = (b.0 - a.0).abs() + (b.1 - a.1).abs() + (c.0 - a.0).abs() + (c.1 - a.1).abs();
+            if area > s as f64 / 512.0 + 1.0 / 65536.0 {
+                quarter_float += 1;
+            }
+            let t = |v: f32| crate::input::fixed_trunc(v) as i64;
+            let at = (t(b.0) - t(a.0)) * (t(c.1) - t(a.1)) - (t(c.0) - t(a.0)) * (t(b.1) - t(a.1));
+            let st = (t(b.0) - t(a.0)).abs()
+                + (t(b.1) - t(a.1)).abs()
+                + (t(c.0) - t(a.0)).abs()
+                + (t(c.1) - t(a.1)).abs();
+            if at.abs() > (3 * st + 34) / 4 {
+                quarter_fixed += 1;
+            }
+        }
+        assert!(
+            wrong_sign > 50_000 && quarter_float > 1_000 && quarter_fixed > 1_000,
+            "{wrong_sign} {quarter_float} {quarter_fixed}"
+        );
+    }
 }
