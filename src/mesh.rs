@@ -1029,6 +1029,54 @@ mod tests {
         assert!(fixed > 150_000, "{fixed}");
     }
 
+    /// Where no filter decides, the cull is the snapped area's sign under every mode: near-zero triangles whose
+    /// snapped area is negative, positive and zero (the adversarial ones below, their mirror images, and triangles
+    /// whose vertices snap onto one line), each against the rule the rasterizer applies.
+    #[test]
+    fn the_cull_of_near_zero_areas_is_the_snapped_areas() {
+        let mut rnd = crate::xorshift(0x0C11_5A1E_0003);
+        let mut unit = move || (rnd() >> 40) as f32 / (1u64 << 24) as f32;
+        let rule = |cull: Cull, area: i64| match cull {
+            _ if area == 0 => true,
+            Cull::Cw => area > 0,
+            Cull::Ccw => area < 0,
+            Cull::None => false,
+        };
+        let mut seen = [0; 3]; // snapped areas below, at and above zero, decided by the snapped area
+        for n in 0..100_000 {
+            let (a, b) = (
+                (unit() * 64.0, unit() * 64.0),
+                (unit() * 64.0, unit() * 64.0),
+            );
+            let t = unit();
+            // On the line through a and b, then moved by under a sub-pixel.
+            let d = (unit() - 0.5) / 128.0;
+            let c = (a.0 + t * (b.0 - a.0) + d, a.1 + t * (b.1 - a.1) - d);
+            let mut tri = if n % 2 == 0 { [a, b, c] } else { [a, c, b] };
+            if n % 3 == 0 {
+                // All three within 2^-11 px of one row of the snap grid: they snap onto it (area 0).
+                let y = (unit() * 64.0 * 256.0).floor() / 256.0;
+                for p in tri.iter_mut() {
+                    p.1 = y + (unit() - 0.5) / 1024.0;
+                }
+            }
+            let v = tri.map(|(x, y)| Projected { x, y, rhw: 1.0 });
+            let snapped = crate::input::snapped_area(tri).unwrap();
+            if clear_area(&v).is_some() {
+                continue;
+            }
+            seen[(snapped.signum() + 1) as usize] += 1;
+            for cull in [Cull::Cw, Cull::Ccw, Cull::None] {
+                assert_eq!(
+                    culled_on_screen(cull, &v),
+                    rule(cull, snapped),
+                    "{tri:?} {cull:?}: snapped {snapped}"
+                );
+            }
+        }
+        assert!(seen.iter().all(|&k| k > 1_000), "{seen:?}");
+    }
+
     /// The filters' bounds are what decides: triangles built so that snapping shrinks the area as far as it can
     /// (every coordinate just beside a half-sub-pixel tie, on the side that rounds against the area) have a positive
     /// area up to about `2^-8 S` whose snapped area is negative. Both filters leave every one of them to the snapped
