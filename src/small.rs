@@ -531,8 +531,15 @@ fn mul_small(x: u64, k: u32) -> u64 {
     mul_wide(x as u32, k).wrapping_add((((x >> 32) as u32).wrapping_mul(k) as u64) << 32)
 }
 
-/// The passing runs of a run of `n <= 32` covered pixels from column `x0` of row `j`: bit `n - 1 - k` of `pass` set
-/// for a written pixel `x0 + k`. Returns how many were written.
+/// One row's `len` pixels from column `x` to the target, as one `fill_solid`.
+#[inline(always)]
+fn fill_run<D: DrawTarget>(t: &mut D, x: i32, j: i32, len: u32, c: D::Color) -> Result<(), Error> {
+    let r = Rectangle::new(Point::new(x, j), Size::new(len, 1));
+    t.fill_solid(&r, c).map_err(|_| Error::Target)
+}
+
+/// The passing runs of a run of `n <= 32` covered pixels from column `x0` of row `j` to the target: bit `n - 1 - k` of
+/// `pass` set for a written pixel `x0 + k`. Returns how many were written.
 #[inline(always)]
 fn emit<D: DrawTarget>(
     target: &mut D,
@@ -542,25 +549,14 @@ fn emit<D: DrawTarget>(
     pass: u32,
     color: D::Color,
 ) -> Result<u32, Error> {
-    #[inline(always)]
-    fn fill_run<D: DrawTarget>(
-        t: &mut D,
-        x: i32,
-        j: i32,
-        len: u32,
-        c: D::Color,
-    ) -> Result<(), Error> {
-        let r = Rectangle::new(Point::new(x, j), Size::new(len, 1));
-        t.fill_solid(&r, c).map_err(|_| Error::Target)
-    }
     if pass == u32::MAX >> (32 - n) {
         fill_run(target, x0, j, n, color)?;
         return Ok(n);
     }
     if ROWS_BY_DIVISION {
-        partial_out(target, x0, j, n, pass, color)
+        partial_out(target, x0, j, (n, pass), color)
     } else {
-        partial(target, x0, j, n, pass, color)
+        partial(target, x0, j, (n, pass), color)
     }
 }
 
@@ -569,37 +565,24 @@ fn emit<D: DrawTarget>(
 /// scan keeps other registers, inline is 0.4% cheaper).
 #[inline(never)]
 fn partial_out<D: DrawTarget>(
-    target: &mut D,
+    t: &mut D,
     x0: i32,
     j: i32,
-    n: u32,
-    pass: u32,
-    color: D::Color,
+    np: (u32, u32),
+    c: D::Color,
 ) -> Result<u32, Error> {
-    partial(target, x0, j, n, pass, color)
+    partial(t, x0, j, np, c)
 }
 
-/// [`emit`] of a run not every pixel of which passed.
+/// [`emit`] of a run not every pixel of which passed (`(n, pass)` as there).
 #[inline(always)]
 fn partial<D: DrawTarget>(
     target: &mut D,
     x0: i32,
     j: i32,
-    n: u32,
-    pass: u32,
+    (n, pass): (u32, u32),
     color: D::Color,
 ) -> Result<u32, Error> {
-    #[inline(always)]
-    fn fill_run<D: DrawTarget>(
-        t: &mut D,
-        x: i32,
-        j: i32,
-        len: u32,
-        c: D::Color,
-    ) -> Result<(), Error> {
-        let r = Rectangle::new(Point::new(x, j), Size::new(len, 1));
-        t.fill_solid(&r, c).map_err(|_| Error::Target)
-    }
     // Runs of set bits from the first pixel (bit n - 1) on: shifted to the top of a u64, whose leading zeros and
     // ones are the gap and the run (a u64 so that shifting out all 32 bits is defined).
     let (mut m, mut at) = (shl64(pass as u64, 64 - n), 0u32); // 1 <= n <= 32: a shift of 32 to 63
