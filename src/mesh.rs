@@ -84,6 +84,7 @@ use crate::projection::Mat4;
 use crate::recip::{SpanRecip, WSpan};
 use crate::transform::IntTransform;
 use crate::{Cull, DepthBuffer, Error, Rasterizer, Stats, Vertex};
+use core::cell::Cell;
 
 /// The colours of a mesh.
 #[derive(Clone, Copy, Debug)]
@@ -147,6 +148,283 @@ struct Bins<'a> {
     culled: u32,
 }
 
+/// Storage for a frame's plane cache ([`MeshFrame::with_plane_cache`]), `N` triangles (28 bytes each, plus 24 on
+/// 32-bit targets).
+///
+/// A frame drawn in bands sets a triangle up again in every band it reaches; on the fast tier the costliest part of
+/// that set-up for vertices off the 1/256 px grid is the depth-grid correction (the plane through the vertices as
+/// given, evaluated at the snapped ones: about 1,690 instructions a triangle on the Cortex-M0, a fifth of W4's
+/// frame there). The cache keeps those values for the triangles that reach the next band, so each is computed
+/// once a frame. It is a function of the triangle alone, so the frames are the same with and without the cache;
+/// a full cache just computes the values again. Bands must come in order, top to bottom, for it to help: a band that
+/// does not start where the previous one ended, a change of the far plane or of the strategy empties it.
+///
+/// A frame in bands of 8 rows, transformed once, binned by rows and cached (all in caller storage):
+/// ```
+/// use embedded_graphics_core::pixelcolor::Rgb565;
+/// use embedded_graphics_core::prelude::*;
+/// use wraster::clip::Viewport;
+/// use wraster::mesh::{Colors, Mesh, PlaneCache, Projected};
+/// use wraster::projection::{Camera, Mat4};
+/// use wraster::{ColorBand, DepthBuffer, Rasterizer};
+///
+/// let positions = [[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]];
+/// let indices = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]];
+/// let mesh = Mesh { positions: &positions, indices: &indices, colors: Colors::Uniform(Rgb565::GREEN) };
+/// let camera = Camera::look_at([0.0, 0.0, 4.0], [0.0; 3], [0.0, 1.0, 0.0],
+///                              core::f32::consts::FRAC_PI_3, 64.0 / 48.0, 0.5, 100.0)?;
+/// let mut r: Rasterizer = Rasterizer::new(camera.render_state()?);
+/// let (mut scratch, mut bins) = ([Projected::default(); 4], [0u8; 4]);
+/// let mut cache = PlaneCache::<8>::new();
+/// let m = camera.model_matrix(&Mat4::rotation_y(0.3));
+/// let frame = r.transform_mesh(&mesh, &m, &Viewport::new(0.0, 0.0, 64.0, 48.0), &mut scratch)?;
+/// let frame = r.bin_mesh(frame, &mut bins)?.with_plane_cache(&mut cache);
+/// let (mut px, mut z) = ([0u16; 64 * 8], [0u16; 64 * 8]);
+/// let mut written = 0;
+/// for y0 in (0..48).step_by(8) {
+///     let mut band = ColorBand::<Rgb565>::band(&mut px, 64, y0, 8)?;
+///     let mut depth = DepthBuffer::band(&mut z, 64, y0, 8)?;
+///     depth.clear();
+///     written += r.draw_mesh_frame(&mut band, &mut depth, &frame)?.written;
+///     // ... send `band.pixels()` to the display's rows y0..y0 + 8 ...
+/// }
+/// assert!(written > 100);
+/// # Ok::<(), wraster::Error>(())
+/// ```
+#[derive(Debug)]
+pub struct PlaneCache<const N: usize> {
+    state: CacheState,
+    slots: [Cell<Slot>; N],
+}
+
+impl<const N: usize> PlaneCache<N> {
+    /// An empty cache (it is emptied again by [`MeshFrame::with_plane_cache`]).
+    pub const fn new() -> Self {
+        PlaneCache {
+            state: CacheState {
+                head: Cell::new(0),
+                len: Cell::new(0),
+                prev: Cell::new(0),
+                // All zero (a static of it is `.bss`); `with_plane_cache` marks it empty.
+                band_end: Cell::new(0),
+                tag: Cell::new(0),
+            },
+            slots: [const { Cell::new(Slot { key: 0, t: [0; 6] }) }; N],
+        }
+    }
+}
+
+impl<const N: usize> Default for PlaneCache<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// A [`MeshFrame`] with a [`PlaneCache`] ([`MeshFrame::with_plane_cache`]), drawn with
+/// [`Rasterizer::draw_mesh_frame`] like the frame itself.
+#[derive(Clone, Copy, Debug)]
+pub struct CachedFrame<'a, C> {
+    frame: MeshFrame<'a, C>,
+    cache: Cache<'a>,
+}
+
+impl<'a, C> CachedFrame<'a, C> {
+    /// The frame.
+    pub fn frame(&self) -> &MeshFrame<'a, C> {
+        &self.frame
+    }
+}
+
+/// What [`Rasterizer::draw_mesh_frame`] draws: a [`MeshFrame`] or a [`CachedFrame`] (sealed). Each is its own
+/// instance of the draw: a firmware that draws only one of them links only that one.
+pub trait DrawFrame<'a, C>: sealed::Frame<'a, C> {}
+impl<'a, C: Copy> DrawFrame<'a, C> for MeshFrame<'a, C> {}
+impl<'a, C: Copy> DrawFrame<'a, C> for CachedFrame<'a, C> {}
+
+mod sealed {
+    use super::{Cache, CachedFrame, MeshFrame, DECLINED};
+    use crate::raster::{NoMemo, TMemo};
+
+    /// Triangle `k`'s memo in a band whose last row is `last`: values from the cache, and kept for a triangle that
+    /// reaches further down.
+    pub struct Remembered<'a> {
+        pub(super) cache: Cache<'a>,
+        pub(super) k: u32,
+        pub(super) last: i32,
+    }
+
+    impl TMemo for Remembered<'_> {
+        #[inline]
+        fn get(&mut self) -> Option<Option<[i64; 3]>> {
+            self.cache.take(self.k)
+        }
+        #[inline]
+        fn put(&mut self, t: Option<[i64; 3]>, last_row: i32) {
+            if last_row > self.last {
+                self.cache.keep(self.k, t);
+            }
+        }
+    }
+
+    /// The frame, and a triangle's memo ([`crate::raster::TMemo`]) in a band.
+    pub trait Frame<'a, C> {
+        type Memo<'m>: TMemo
+        where
+            Self: 'm;
+        fn frame(&self) -> &MeshFrame<'a, C>;
+        /// A band of rows `[y0, y0 + h)` begins, drawn with `tag`.
+        fn begin(&self, y0: i32, h: u16, tag: u64);
+        /// Triangle `k`'s memo (`None`: a clipped triangle's fan) in a band whose last row is `last`.
+        fn memo(&self, k: Option<usize>, last: i32) -> Self::Memo<'_>;
+    }
+
+    impl<'a, C> Frame<'a, C> for MeshFrame<'a, C> {
+        type Memo<'m>
+            = NoMemo
+        where
+            Self: 'm;
+        #[inline(always)]
+        fn frame(&self) -> &MeshFrame<'a, C> {
+            self
+        }
+        #[inline(always)]
+        fn begin(&self, _: i32, _: u16, _: u64) {}
+        #[inline(always)]
+        fn memo(&self, _: Option<usize>, _: i32) -> NoMemo {
+            NoMemo
+        }
+    }
+
+    impl<'a, C> Frame<'a, C> for CachedFrame<'a, C> {
+        type Memo<'m>
+            = Option<Remembered<'m>>
+        where
+            Self: 'm;
+        #[inline(always)]
+        fn frame(&self) -> &MeshFrame<'a, C> {
+            &self.frame
+        }
+        #[inline]
+        fn begin(&self, y0: i32, h: u16, tag: u64) {
+            self.cache.begin(y0, h, tag);
+        }
+        #[inline(always)]
+        fn memo(&self, k: Option<usize>, last: i32) -> Option<Remembered<'_>> {
+            // Keys are 31 bits: a triangle beyond (a 64-bit host) is not cached.
+            let k = u32::try_from(k?).ok().filter(|&k| k < DECLINED)?;
+            Some(Remembered {
+                cache: self.cache,
+                k,
+                last,
+            })
+        }
+    }
+}
+
+/// A remembered triangle: its index (bit 31 set where the values were declined: `None`) and its depth-grid values,
+/// each `i64` as two `u32` halves (so a slot is aligned to 4 bytes and takes 28, not 32).
+#[derive(Clone, Copy, Debug)]
+struct Slot {
+    key: u32,
+    t: [u32; 6],
+}
+
+/// Bit 31 of [`Slot::key`]: no values (the key is the triangle's index, below 2^31: larger ones are not cached).
+const DECLINED: u32 = 1 << 31;
+
+/// The cache's ring: `len` slots from `head`, of which the first `prev` were left by the previous band (in
+/// increasing triangle order, the order [`MeshFrame::for_each`] visits), the rest by the current one.
+#[derive(Debug)]
+struct CacheState {
+    head: Cell<usize>,
+    len: Cell<usize>,
+    prev: Cell<usize>,
+    /// The row after the last band's, and what the values depend on besides the triangle (strategy, far plane).
+    band_end: Cell<i32>,
+    tag: Cell<u64>,
+}
+
+/// A frame's view of a [`PlaneCache`].
+#[derive(Clone, Copy, Debug)]
+struct Cache<'a> {
+    state: &'a CacheState,
+    slots: &'a [Cell<Slot>],
+}
+
+impl Cache<'_> {
+    /// A band of rows `[y0, y0 + h)`: the previous band's entries become the ones to look up when it is the next
+    /// band of the same frame drawn the same way (`tag`); otherwise the cache is emptied.
+    fn begin(&self, y0: i32, h: u16, tag: u64) {
+        let st = self.state;
+        if st.band_end.get() == y0 && st.tag.get() == tag && !self.slots.is_empty() {
+            // Entries the previous band left unread: their triangles did not come back.
+            let p = st.prev.get();
+            st.head.set((st.head.get() + p) % self.slots.len());
+            st.len.set(st.len.get() - p);
+        } else {
+            st.head.set(0);
+            st.len.set(0);
+        }
+        st.prev.set(st.len.get());
+        st.band_end.set(y0.saturating_add(h as i32));
+        st.tag.set(tag);
+    }
+
+    /// Triangle `k`'s values from the previous band, if it left them (entries of smaller triangles are dropped:
+    /// they did not come back).
+    fn take(&self, k: u32) -> Option<Option<[i64; 3]>> {
+        let st = self.state;
+        while st.prev.get() > 0 {
+            let head = st.head.get();
+            let e = self.slots[head].get();
+            let key = e.key & !DECLINED;
+            if key > k {
+                return None;
+            }
+            st.head.set(if head + 1 == self.slots.len() {
+                0
+            } else {
+                head + 1
+            });
+            st.len.set(st.len.get() - 1);
+            st.prev.set(st.prev.get() - 1);
+            if key == k {
+                let t = &e.t;
+                return Some((e.key & DECLINED == 0).then(|| {
+                    let join = |lo: u32, hi: u32| ((hi as u64) << 32 | lo as u64) as i64;
+                    [join(t[0], t[1]), join(t[2], t[3]), join(t[4], t[5])]
+                }));
+            }
+        }
+        None
+    }
+
+    /// Keeps triangle `k`'s values for the next band (dropped when the cache is full).
+    fn keep(&self, k: u32, t: Option<[i64; 3]>) {
+        let (st, n) = (self.state, self.slots.len());
+        let len = st.len.get();
+        if len < n {
+            let at = (st.head.get() + len) % n;
+            let (key, t) = match t {
+                Some(t) => (k, t),
+                None => (k | DECLINED, [0; 3]),
+            };
+            self.slots[at].set(Slot {
+                key,
+                t: [
+                    t[0] as u32,
+                    (t[0] >> 32) as u32,
+                    t[1] as u32,
+                    (t[1] >> 32) as u32,
+                    t[2] as u32,
+                    (t[2] >> 32) as u32,
+                ],
+            });
+            st.len.set(len + 1);
+        }
+    }
+}
+
 /// Row buckets: 0 to 253. A frame whose top rows span under 254 rows has a bucket per row.
 const BUCKETS: i32 = 254;
 /// A triangle's byte when it needs clipping (visited by every band), and when it was culled (by none).
@@ -179,6 +457,27 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
     pub fn vertices(&self) -> &'a [Projected] {
         self.verts
     }
+    /// This frame with a plane cache (`cache`, emptied here): drawn band by band, top to bottom, with
+    /// [`Rasterizer::draw_mesh_frame`], a triangle that reaches several bands has its depth-grid values computed once
+    /// instead of in each (see [`PlaneCache`]). The same pixels and codes as without it. A type of its own, so a
+    /// firmware that never caches links no cache code.
+    pub fn with_plane_cache<const N: usize>(
+        self,
+        cache: &'a mut PlaneCache<N>,
+    ) -> CachedFrame<'a, C> {
+        let cache: &'a PlaneCache<N> = cache;
+        cache.state.band_end.set(i32::MIN);
+        cache.state.len.set(0);
+        cache.state.prev.set(0);
+        CachedFrame {
+            frame: self,
+            cache: Cache {
+                state: &cache.state,
+                slots: &cache.slots,
+            },
+        }
+    }
+
     /// The triangles [`Rasterizer::bin_mesh`] culled (`None` for a frame not binned).
     pub fn binned_culled(&self) -> Option<u32> {
         self.bins.map(|b| b.culled)
@@ -195,8 +494,8 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
     }
 
     /// Visits the triangles that can touch rows `[y0, y0 + h)`, culled and clipped, as screen-space triangles
-    /// (`f(vertices, per-vertex colours)` with the barycentric colour weights already applied by `mix`), in
-    /// increasing triangle order. A binned frame ([`Rasterizer::bin_mesh`], with the same cull mode) tests a byte per
+    /// (`f(k, vertices)`: `k` the triangle's index, `None` for the fan of a clipped one; the vertices' colours with
+    /// the barycentric weights already applied by `mix`), in increasing triangle order. A binned frame ([`Rasterizer::bin_mesh`], with the same cull mode) tests a byte per
     /// triangle and looks further only at those in the buckets the band can reach and those to clip, so it draws
     /// exactly the triangles, in the same order, as the walk over all of them; its screen triangles were culled
     /// once by the binning.
@@ -207,7 +506,7 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
         h: u16,
         stats: &mut Stats,
         mix: &impl Fn([C; 3], [f32; 3]) -> C,
-        mut f: impl FnMut([Vertex<C>; 3]) -> Result<Stats, E>,
+        mut f: impl FnMut(Option<usize>, [Vertex<C>; 3]) -> Result<Stats, E>,
     ) -> Result<(), E> {
         // Rows whose centre can be covered: y in [y0 + 0.5, y0 + h - 0.5], less 0.01 px of slack for the snap (which
         // moves y by at most 1/512 px) and the bounds' own rounding (below 2^-11 px for |y| < 2^12). Compared as
@@ -258,7 +557,7 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
         (top, bottom): (i32, i32),
         stats: &mut Stats,
         mix: &impl Fn([C; 3], [f32; 3]) -> C,
-        f: &mut impl FnMut([Vertex<C>; 3]) -> Result<Stats, E>,
+        f: &mut impl FnMut(Option<usize>, [Vertex<C>; 3]) -> Result<Stats, E>,
     ) -> Result<(), E> {
         let idx = tri.map(|i| i as usize);
         let [a, b, c] = idx.map(|i| self.verts[i]);
@@ -273,15 +572,34 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
                 return Ok(());
             }
             let v = [a, b, c];
-            *stats += f(core::array::from_fn(|i| Vertex {
-                x: v[i].x,
-                y: v[i].y,
-                z: 0.0,
-                rhw: v[i].rhw,
-                color: vc[i],
-            }))?;
+            *stats += f(
+                Some(k),
+                core::array::from_fn(|i| Vertex {
+                    x: v[i].x,
+                    y: v[i].y,
+                    z: 0.0,
+                    rhw: v[i].rhw,
+                    color: vc[i],
+                }),
+            )?;
             return Ok(());
         }
+        self.clipped(k, idx, cull, stats, mix, f)
+    }
+
+    /// The clipping half of [`MeshFrame::triangle`]: out of line, so the polygons' stack (two of
+    /// [`crate::clip`]'s `Poly`) is taken only by a triangle that crosses a plane, not by every screen triangle's draw
+    /// (on the Cortex-M0's 16 KiB, the stack's depth decides how tall the bands can be).
+    #[inline(never)]
+    fn clipped<E>(
+        &self,
+        k: usize,
+        idx: [usize; 3],
+        cull: Cull,
+        stats: &mut Stats,
+        mix: &impl Fn([C; 3], [f32; 3]) -> C,
+        f: &mut impl FnMut(Option<usize>, [Vertex<C>; 3]) -> Result<Stats, E>,
+    ) -> Result<(), E> {
         let vc = self.colors(k, idx);
         // Needs clipping: the positions were checked by transform_mesh, so these cannot fail.
         let cl = idx.map(|i| to_clip(&self.m, &self.mesh.positions[i]).unwrap_or([0.0; 4]));
@@ -303,7 +621,7 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
             return Ok(());
         };
         for j in 1..poly.len().saturating_sub(1) {
-            *stats += f(fan(&self.planes, &poly, j, &|w| mix(vc, w)))?;
+            *stats += f(None, fan(&self.planes, &poly, j, &|w| mix(vc, w)))?;
         }
         Ok(())
     }
@@ -602,21 +920,26 @@ impl<R: SpanRecip> Rasterizer<R> {
     /// Draws a transformed mesh into `depth` (a whole frame or a band: only the triangles that can touch its rows
     /// are set up), flat-shaded, back faces dropped as the render state's [`Cull`] says. With the render state the
     /// frame was transformed with, it fails only when `target` fails (then as [`Rasterizer::draw`] says).
-    pub fn draw_mesh_frame<D>(
+    pub fn draw_mesh_frame<'a, D, F>(
         &mut self,
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
-        frame: &MeshFrame<'_, D::Color>,
+        frame: &F,
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
-        D::Color: PixelColor,
+        D::Color: PixelColor + 'a,
+        F: DrawFrame<'a, D::Color>,
     {
         let mut stats = Stats::default();
         let (y0, h, cull) = (depth.y0(), depth.height(), self.state.cull);
-        frame.for_each(cull, y0, h, &mut stats, &|c, _| c[0], |v| {
-            self.draw(target, depth, &v)
-        })?;
+        frame.begin(y0, h, self.memo_tag());
+        let last = y0.saturating_add(h as i32 - 1);
+        frame
+            .frame()
+            .for_each(cull, y0, h, &mut stats, &|c, _| c[0], |k, v| {
+                self.draw_memo(target, depth, &v, &mut frame.memo(k, last))
+            })?;
         Ok(stats)
     }
 
@@ -668,7 +991,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         };
         let mut stats = Stats::default();
         let (y0, h, cull) = (depth.y0(), depth.height(), self.state.cull);
-        frame.for_each(cull, y0, h, &mut stats, &mix, |v| {
+        frame.for_each(cull, y0, h, &mut stats, &mix, |_, v| {
             self.draw_gouraud(target, depth, &v)
         })?;
         Ok(stats)
@@ -941,6 +1264,189 @@ mod tests {
         let mut band = crate::DepthBuffer::band(&mut data, 64, 10, 4).unwrap();
         let s = r.draw_mesh_frame(&mut Null, &mut band, &frame).unwrap();
         assert_eq!(s.culled, 1, "{s:?}");
+    }
+
+    /// W4's frame `k` drawn in bands of `rows` rows (in `order`: top to bottom, or the reverse), binned or not, with a
+    /// plane cache of `N` slots or none: the frame's colours and depths, the calls of `t_at_snapped`, the triangles
+    /// (by their snapped vertices) it was called for, and every triangle's values as the draws used them (once each).
+    #[cfg(feature = "scenes")]
+    #[allow(clippy::type_complexity)]
+    type Drawn = (
+        Vec<u16>,
+        Vec<u16>,
+        usize,
+        usize,
+        Vec<([(i32, i32); 3], Option<[i64; 3]>)>,
+    );
+
+    #[cfg(feature = "scenes")]
+    fn torus_in_bands<R: SpanRecip, const N: usize>(
+        k: usize,
+        rows: u16,
+        binned: bool,
+        cache: Option<&mut PlaneCache<N>>,
+        reverse: bool,
+        alternate: bool,
+    ) -> Drawn {
+        use crate::scenes::torus;
+        use embedded_graphics_core::pixelcolor::Rgb565;
+        let (w, h) = (320u16, 240u16);
+        let (positions, indices, colors) = (torus::positions(), torus::indices(), torus::colors());
+        let mesh = Mesh {
+            positions: &positions,
+            indices: &indices,
+            colors: Colors::PerFace(&colors),
+        };
+        let cam = torus::camera().unwrap();
+        let mut r = Rasterizer::<R>::new(cam.render_state().unwrap());
+        let vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
+        let (mut verts, mut bins) = (
+            vec![Projected::default(); torus::VERTICES],
+            vec![0u8; torus::TRIANGLES],
+        );
+        let m = cam.model_matrix(&torus::model(k));
+        let mut frame = r.transform_mesh(&mesh, &m, &vp, &mut verts).unwrap();
+        if binned {
+            frame = r.bin_mesh(frame, &mut bins).unwrap();
+        }
+        // `alternate`: every second and third band of three by another strategy, with the far plane further out
+        // (the cache must not hand one's values to the other).
+        let mut other = cam.render_state().unwrap();
+        other.range = crate::DepthRange::new(torus::DEPTH.0, torus::DEPTH.1 * 1.5).unwrap();
+        let (mut r2, mut r3) = (
+            Rasterizer::<crate::recip::FastDiv>::new(other),
+            Rasterizer::<crate::recip::Fast>::new(other),
+        );
+        let (mut color, mut depth) = (
+            vec![0u16; w as usize * h as usize],
+            vec![0u16; w as usize * h as usize],
+        );
+        crate::raster::T_AT_SNAPPED_CALLS.with(|c| c.borrow_mut().clear());
+        crate::raster::FAST_T_USED.with(|c| c.borrow_mut().clear());
+        let mut y0s: Vec<u16> = (0..h).step_by(rows as usize).collect();
+        if reverse {
+            y0s.reverse();
+        }
+        let mut bands =
+            |f: &mut dyn FnMut(&mut crate::ColorBand<'_, Rgb565>, &mut DepthBuffer<'_>, u16)| {
+                for &y0 in &y0s {
+                    let n = rows.min(h - y0);
+                    let at = y0 as usize * w as usize..(y0 + n) as usize * w as usize;
+                    let mut band =
+                        crate::ColorBand::<Rgb565>::band(&mut color[at.clone()], w, y0 as i32, n)
+                            .unwrap();
+                    let mut buf =
+                        crate::DepthBuffer::band(&mut depth[at], w, y0 as i32, n).unwrap();
+                    buf.clear();
+                    f(&mut band, &mut buf, y0 / rows % 3);
+                }
+            };
+        fn one<'a, F: DrawFrame<'a, Rgb565>, R: SpanRecip>(
+            r: &mut Rasterizer<R>,
+            band: &mut crate::ColorBand<'_, Rgb565>,
+            buf: &mut DepthBuffer<'_>,
+            frame: &F,
+        ) {
+            r.draw_mesh_frame(band, buf, frame).unwrap();
+        }
+        match cache {
+            Some(c) => {
+                let frame = frame.with_plane_cache(c);
+                bands(&mut |band, buf, turn| match (alternate, turn) {
+                    (true, 1) => one(&mut r2, band, buf, &frame),
+                    (true, 2) => one(&mut r3, band, buf, &frame),
+                    _ => one(&mut r, band, buf, &frame),
+                });
+            }
+            None => bands(&mut |band, buf, turn| match (alternate, turn) {
+                (true, 1) => one(&mut r2, band, buf, &frame),
+                (true, 2) => one(&mut r3, band, buf, &frame),
+                _ => one(&mut r, band, buf, &frame),
+            }),
+        }
+        let mut calls = crate::raster::T_AT_SNAPPED_CALLS.with(|c| c.take());
+        let n = calls.len();
+        calls.sort_unstable();
+        calls.dedup();
+        let mut used = crate::raster::FAST_T_USED.with(|c| c.take());
+        used.sort_unstable();
+        used.dedup();
+        (color, depth, n, calls.len(), used)
+    }
+
+    /// The plane cache draws exactly what the frame draws without it (W4's frames, both fast strategies, binned and
+    /// not, bands of 1 to 8 rows, caches of 1 to 200 slots), computes the depth-grid values no more often, and, with
+    /// room for every triangle that crosses a band's edge, exactly as often as one band of the whole frame does
+    /// (once per triangle). Bands drawn bottom to top (not the next band each time) empty it: the same count as
+    /// without a cache. A cache left from another frame or strategy is emptied by `with_plane_cache`.
+    #[test]
+    #[cfg(feature = "scenes")]
+    fn the_plane_cache_draws_the_same_and_computes_each_triangle_once() {
+        fn check<R: SpanRecip>() {
+            let (mut small, mut mid, mut big) = (
+                PlaneCache::<1>::new(),
+                PlaneCache::<26>::new(),
+                PlaneCache::<200>::new(),
+            );
+            for k in [0, 3, 6] {
+                let (c1, d1, ..) = torus_in_bands::<R, 0>(k, 240, false, None, false, false);
+                for (rows, binned) in [(4, true), (1, false), (8, true), (7, false)] {
+                    // Without a cache: each triangle in every band it reaches.
+                    let (c, d, plain, distinct, used) =
+                        torus_in_bands::<R, 0>(k, rows, binned, None, false, false);
+                    assert!(c == c1 && d == d1);
+                    assert!(
+                        distinct > 300 && plain > distinct + distinct / 2,
+                        "{plain} {distinct}"
+                    );
+                    // Each triangle's values exactly as computed (a remembered value is the computed one).
+                    assert_eq!(used.len(), distinct);
+                    let (c, d, n, m, u) =
+                        torus_in_bands::<R, 1>(k, rows, binned, Some(&mut small), false, false);
+                    assert!(
+                        c == c1
+                            && d == d1
+                            && u == used
+                            && n <= plain
+                            && n > distinct
+                            && m == distinct,
+                        "{n}"
+                    );
+                    let (c, d, n, m, u) =
+                        torus_in_bands::<R, 26>(k, rows, binned, Some(&mut mid), false, false);
+                    assert!(
+                        c == c1
+                            && d == d1
+                            && u == used
+                            && n < plain
+                            && n >= distinct
+                            && m == distinct,
+                        "{n}"
+                    );
+                    // Room for every crossing triangle: each computed once.
+                    let (c, d, n, m, u) =
+                        torus_in_bands::<R, 200>(k, rows, binned, Some(&mut big), false, false);
+                    assert!(c == c1 && d == d1 && u == used, "rows {rows}");
+                    assert!(
+                        n == distinct && m == distinct,
+                        "rows {rows}: {n} {m} {distinct}"
+                    );
+                    // Bottom to top: no band follows the previous one, so nothing is reused.
+                    let (c, d, n, _, u) =
+                        torus_in_bands::<R, 200>(k, rows, binned, Some(&mut big), true, false);
+                    assert!(c == c1 && d == d1 && u == used && n == plain, "{n} {plain}");
+                    // Bands by turns with other strategies and far planes: what they would draw without a cache, and
+                    // nothing reused (no band is drawn as the previous one was).
+                    let (c2, d2, plain, _, used) =
+                        torus_in_bands::<R, 0>(k, rows, binned, None, false, true);
+                    let (c, d, n, _, u) =
+                        torus_in_bands::<R, 200>(k, rows, binned, Some(&mut big), false, true);
+                    assert!(c == c2 && d == d2 && u == used && n == plain, "{n} {plain}");
+                }
+            }
+        }
+        check::<crate::recip::Fast>();
+        check::<crate::recip::FastDiv>();
     }
 
     /// `trunc_bits` (the cores without an FPU) is `as i32` (the FPU's conversion) on every class of f32: a stride

@@ -130,6 +130,39 @@ pub(crate) struct Setup<const N: usize = 3> {
     pub(crate) frac: u32,
 }
 
+/// Where [`Rasterizer::draw_memo`] finds and leaves a triangle's [`t_at_snapped`] values.
+pub trait TMemo {
+    /// The values remembered for this triangle, if any.
+    fn get(&mut self) -> Option<Option<[i64; 3]>>;
+    /// This triangle's values, and its last row (the memo keeps them only for a triangle that reaches a later band).
+    fn put(&mut self, t: Option<[i64; 3]>, last_row: i32);
+}
+
+impl<M: TMemo> TMemo for Option<M> {
+    #[inline(always)]
+    fn get(&mut self) -> Option<Option<[i64; 3]>> {
+        self.as_mut().and_then(|m| m.get())
+    }
+    #[inline(always)]
+    fn put(&mut self, t: Option<[i64; 3]>, last_row: i32) {
+        if let Some(m) = self {
+            m.put(t, last_row);
+        }
+    }
+}
+
+/// No memo: every draw computes its values.
+pub struct NoMemo;
+
+impl TMemo for NoMemo {
+    #[inline(always)]
+    fn get(&mut self) -> Option<Option<[i64; 3]>> {
+        None
+    }
+    #[inline(always)]
+    fn put(&mut self, _: Option<[i64; 3]>, _: i32) {}
+}
+
 /// Rows whose pixel centre lies in the snapped vertices' y-range (possibly empty: first > last).
 pub(crate) fn rows_of(p: &[Sub; 3]) -> (i32, i32) {
     let ymin = p[0].y.min(p[1].y).min(p[2].y);
@@ -411,6 +444,29 @@ impl<R: SpanRecip> Rasterizer<R> {
         D: DrawTarget,
         D::Color: PixelColor,
     {
+        self.draw_memo(target, depth, v, &mut NoMemo)
+    }
+
+    /// What a remembered [`t_at_snapped`] value depends on besides the triangle: the strategy's way to it and the far
+    /// plane (the vertices' `T`).
+    pub(crate) fn memo_tag(&self) -> u64 {
+        ((R::DIV_SEED as u64) << 32) | self.state.range.far().to_bits() as u64
+    }
+
+    /// [`Rasterizer::draw`], with `memo` keeping the fast tier's depth-grid values ([`t_at_snapped`]) across the
+    /// bands of a frame (the mesh's [`crate::mesh::PlaneCache`]); the values are a function of the triangle alone, so
+    /// a remembered one draws exactly what a computed one does.
+    pub(crate) fn draw_memo<D>(
+        &mut self,
+        target: &mut D,
+        depth: &mut DepthBuffer<'_>,
+        v: &[impl VertexInput<Color = D::Color>; 3],
+        memo: &mut impl TMemo,
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
         let (cmp, write) = self.w16_test()?;
         depth.note_compare(cmp, write);
         let mut s = self.setup(v)?;
@@ -422,11 +478,14 @@ impl<R: SpanRecip> Rasterizer<R> {
             && first <= depth.y0().saturating_add(depth.height() as i32 - 1)
             && last >= depth.y0()
         {
-            s.fast_t = if R::DIV_SEED {
-                t_at_snapped::<true>(&s)
-            } else {
-                t_at_snapped::<false>(&s)
+            s.fast_t = match memo.get() {
+                Some(t) => t,
+                None if R::DIV_SEED => t_at_snapped::<true>(&s),
+                None => t_at_snapped::<false>(&s),
             };
+            memo.put(s.fast_t, last);
+            #[cfg(test)]
+            FAST_T_USED.with(|c| c.borrow_mut().push((s.p.map(|p| (p.x, p.y)), s.fast_t)));
         }
         if R::FAST_W16 && cmp == Compare::Less && write && !self.state.has_bias() {
             // The strategy's seed (a constant of `R`: the other branch is not compiled into the firmware).
@@ -683,6 +742,8 @@ fn depth_plane(
 /// the bound, so the strategy decides, and each strategy's frames stay the same on every core.
 #[inline(never)] // once per triangle: out of line, one copy (flash)
 pub(crate) fn t_at_snapped<const NARROW: bool>(s: &Setup) -> Option<[i64; 3]> {
+    #[cfg(test)]
+    T_AT_SNAPPED_CALLS.with(|c| c.borrow_mut().push(s.p.map(|p| (p.x, p.y))));
     if !NARROW {
         return t_at_snapped_wide(s);
     }
@@ -691,6 +752,18 @@ pub(crate) fn t_at_snapped<const NARROW: bool>(s: &Setup) -> Option<[i64; 3]> {
         Narrow::Steep => None,
         Narrow::Unsure => t_at_snapped_wide(s),
     }
+}
+
+#[cfg(test)]
+std::thread_local! {
+    /// The snapped vertices of each call of [`t_at_snapped`] on this thread (tests of the mesh's plane cache count
+    /// what it saves).
+    pub(crate) static T_AT_SNAPPED_CALLS: core::cell::RefCell<std::vec::Vec<[(i32, i32); 3]>> =
+        const { core::cell::RefCell::new(std::vec::Vec::new()) };
+    /// The snapped vertices and the depth-grid values of each draw that used them (computed or remembered).
+    #[allow(clippy::type_complexity)]
+    pub(crate) static FAST_T_USED: core::cell::RefCell<std::vec::Vec<([(i32, i32); 3], Option<[i64; 3]>)>> =
+        const { core::cell::RefCell::new(std::vec::Vec::new()) };
 }
 
 /// What [`t_at_snapped_narrow`] found.

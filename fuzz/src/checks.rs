@@ -12,7 +12,7 @@ use embedded_graphics_core::prelude::Size;
 use wraster::clip::Viewport;
 use wraster::format::{W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
 use wraster::input::{I24F8, U16F16, U1F31, U8F24};
-use wraster::mesh::{Colors, Mesh, Projected};
+use wraster::mesh::{Colors, Mesh, PlaneCache, Projected};
 use wraster::projection::{self, Camera, Mat4};
 use wraster::recip::{Exact, Fast, Linear, Newton, PerPixel, PrevPixel, Quake, SpanRecip, WSpan};
 use wraster::{
@@ -713,26 +713,44 @@ pub fn world(data: &[u8]) {
             }
             Ok(binned) => {
                 assert!(binned.binned_culled().is_some());
-                let mut bcanvas = Canvas::new(w as u32, h as u32);
-                let mut bdepth = Guarded::new(n, 0u16, 0x5a5a);
-                bdepth.inner().copy_from_slice(&cleared);
-                let mut bsum = Ok(Stats::default());
-                for y0 in (0..h).step_by(band as usize) {
-                    let hh = band.min(h - y0);
-                    let rows = y0 as usize * w as usize..(y0 + hh) as usize * w as usize;
-                    let mut buf =
-                        DepthBuffer::band(&mut bdepth.inner()[rows], w, y0 as i32, hh).unwrap();
-                    add(
-                        &mut bsum,
-                        draw_frame(&mut r, &mut bcanvas, &mut buf, &Ok(binned)),
+                // The frame drawn band by band (`draw` one band): the same picture, codes, fragments and writes as
+                // the unbinned frame.
+                let mut same_in_bands = |what: &str,
+                                         draw: &mut dyn FnMut(
+                    &mut Rasterizer,
+                    &mut Canvas,
+                    &mut DepthBuffer,
+                )
+                    -> Result<Stats, Error>| {
+                    let mut bcanvas = Canvas::new(w as u32, h as u32);
+                    let mut bdepth = Guarded::new(n, 0u16, 0x5a5a);
+                    bdepth.inner().copy_from_slice(&cleared);
+                    let mut bsum = Ok(Stats::default());
+                    for y0 in (0..h).step_by(band as usize) {
+                        let hh = band.min(h - y0);
+                        let rows = y0 as usize * w as usize..(y0 + hh) as usize * w as usize;
+                        let mut buf =
+                            DepthBuffer::band(&mut bdepth.inner()[rows], w, y0 as i32, hh).unwrap();
+                        add(&mut bsum, draw(&mut r, &mut bcanvas, &mut buf));
+                    }
+                    bdepth.check();
+                    same_result(&mwhole, bsum);
+                    assert!(
+                        mcanvas.same_picture(&bcanvas) && mdepth.data() == bdepth.data(),
+                        "mesh: the {what} frame differs"
                     );
+                };
+                same_in_bands("binned", &mut |r, c, d| draw_frame(r, c, d, &Ok(binned)));
+                // With a plane cache (3 slots, or 64; the flat draw: Gouraud's has no cache).
+                if !gouraud {
+                    let (mut few, mut many) = (PlaneCache::<3>::new(), PlaneCache::<64>::new());
+                    let cached = if b.u8() % 2 == 0 {
+                        binned.with_plane_cache(&mut few)
+                    } else {
+                        binned.with_plane_cache(&mut many)
+                    };
+                    same_in_bands("cached", &mut |r, c, d| r.draw_mesh_frame(c, d, &cached));
                 }
-                bdepth.check();
-                same_result(&mwhole, bsum);
-                assert!(
-                    mcanvas.same_picture(&bcanvas) && mdepth.data() == bdepth.data(),
-                    "mesh: the binned frame differs"
-                );
             }
         }
     }

@@ -93,13 +93,19 @@ fn main() -> ! {
     // The row bins (`Rasterizer::bin_mesh`, a byte per triangle): each of the 60 bands sets up only the triangles
     // that can reach it.
     static mut BINS: [u8; TRIANGLES] = [0; TRIANGLES];
+    // The plane cache (`wraster::mesh::PlaneCache`, 25 triangles, 724 bytes): a triangle reaching several bands has
+    // its depth-grid values computed once a frame, not in each band.
+    static mut CACHE: wraster_board::TorusCache = wraster_board::TorusCache::new();
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
+    // Out of line: one strategy's run at a time on the stack (measured by CI's `stack` line).
+    #[inline(never)]
     fn torus<R: wraster::recip::SpanRecip>(
         color: &mut [u16],
         depth: &mut [u16],
         verts: &mut [Projected],
         bins: &mut [u8],
+        cache: &mut wraster_board::TorusCache,
         counter: &mut SysTick,
     ) -> bool {
         wraster_board::run_torus_line::<R, _>(
@@ -109,17 +115,18 @@ fn main() -> ! {
             depth,
             verts,
             bins,
+            cache,
             counter,
             |line| hprintln!("{}", line),
         )
     }
-    let ok = torus::<Fast>(COLOR, DEPTH, VERTS, BINS, &mut counter);
+    let ok = torus::<Fast>(COLOR, DEPTH, VERTS, BINS, CACHE, &mut counter);
     // `--features size-probe`: the default strategy only (profiles).
     #[cfg(not(feature = "size-probe"))]
     let ok = ok
-        & torus::<FastDiv>(COLOR, DEPTH, VERTS, BINS, &mut counter)
-        & torus::<Exact>(COLOR, DEPTH, VERTS, BINS, &mut counter)
-        & torus::<PrevPixel>(COLOR, DEPTH, VERTS, BINS, &mut counter);
+        & torus::<FastDiv>(COLOR, DEPTH, VERTS, BINS, CACHE, &mut counter)
+        & torus::<Exact>(COLOR, DEPTH, VERTS, BINS, CACHE, &mut counter)
+        & torus::<PrevPixel>(COLOR, DEPTH, VERTS, BINS, CACHE, &mut counter);
     // `--features cull`: W4's build also measures the bounding-sphere cull (README: leaving work out at run time).
     #[cfg(feature = "cull")]
     let ok = ok

@@ -55,6 +55,7 @@ fn all<R: SpanRecip>(
         depth,
         verts,
         &mut [],
+        &mut (), // one band: nothing to cache
         counter,
         |line| hprintln!("{}", line),
     )
@@ -102,6 +103,7 @@ fn main() -> ! {
             BOUND,
             VERTS,
             &mut [],
+            &mut (),
             &mut counter,
             |line| hprintln!("{}", line),
         );

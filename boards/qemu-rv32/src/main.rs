@@ -55,6 +55,7 @@ fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], verts: &mut [Projecte
         depth,
         verts,
         &mut [], // one band: nothing to bin
+        &mut (), // nor to cache
         &mut Minstret(0),
         |line| hprintln!("{}", line),
     )

@@ -100,6 +100,8 @@ fn main() -> ! {
     let mut verts = [Projected::default(); VERTICES];
     // Row bins for the 15 bands (`Rasterizer::bin_mesh`): each band sets up only the triangles that can reach it.
     let mut bins = [0u8; TRIANGLES];
+    // The plane cache: a triangle reaching several bands has its depth-grid values computed once a frame.
+    let mut cache = wraster_board::TorusCache::new();
     let mut k = 0;
     loop {
         let _ = run_torus_with::<Fast, _>(
@@ -107,6 +109,7 @@ fn main() -> ! {
             &mut depth,
             &mut verts,
             &mut bins,
+            &mut cache,
             &mut NoCounter,
             k..k + 1,
             &mut push,
