@@ -746,7 +746,17 @@ pub fn run_torus_with<R: SpanRecip, C: Counter>(
     frames: core::ops::Range<usize>,
     on_band: impl FnMut(u16, &[u16]),
 ) -> Result<Run, Error> {
-    run_torus_bounded::<R, C>(color, depth, &mut [], verts, bins, cache, counter, frames, on_band)
+    run_torus_bounded::<R, C>(
+        color,
+        depth,
+        &mut [],
+        verts,
+        bins,
+        cache,
+        counter,
+        frames,
+        on_band,
+    )
 }
 
 /// [`run_torus_with`], each band's depth buffer keeping a coarse bound in `bound` (feature `coarse`; empty: none).
