@@ -655,7 +655,7 @@ impl TorusFrames for () {
     }
 }
 
-impl TorusFrames for TorusCache {
+impl<const N: usize> TorusFrames for wraster::mesh::PlaneCache<N> {
     type Frame<'a> = wraster::mesh::CachedFrame<'a, Rgb565>;
     fn attach<'a>(&'a mut self, f: MeshFrame<'a, Rgb565>) -> Self::Frame<'a> {
         f.with_plane_cache(self)
