@@ -1366,28 +1366,30 @@ mod tests {
                     f(&mut band, &mut buf, y0 / rows % 3);
                 }
             };
-        fn one<'a, F: DrawFrame<'a, Rgb565>, R: SpanRecip>(
-            r: &mut Rasterizer<R>,
-            band: &mut crate::ColorBand<'_, Rgb565>,
-            buf: &mut DepthBuffer<'_>,
-            frame: &F,
-        ) {
-            r.draw_mesh_frame(band, buf, frame).unwrap();
-        }
-        match cache {
-            Some(c) => {
-                let frame = frame.with_plane_cache(c);
-                bands(&mut |band, buf, turn| match (alternate, turn) {
-                    (true, 1) => one(&mut r2, band, buf, &frame),
-                    (true, 2) => one(&mut r3, band, buf, &frame),
-                    _ => one(&mut r, band, buf, &frame),
-                });
+        // Draws band `turn` of three of `frame` (`alternate`: the second and third by the other rasterizers).
+        type Rs<'r, R> = (
+            &'r mut Rasterizer<R>,
+            &'r mut Rasterizer<crate::recip::FastDiv>,
+            &'r mut Rasterizer<crate::recip::Fast>,
+        );
+        fn drawer<'a, 'r, F: DrawFrame<'a, Rgb565>, R: SpanRecip>(
+            frame: &'r F,
+            rs: Rs<'r, R>,
+            alternate: bool,
+        ) -> impl FnMut(&mut crate::ColorBand<'_, Rgb565>, &mut DepthBuffer<'_>, u16) + 'r {
+            move |band, buf, turn| {
+                match (alternate, turn) {
+                    (true, 1) => rs.1.draw_mesh_frame(band, buf, frame),
+                    (true, 2) => rs.2.draw_mesh_frame(band, buf, frame),
+                    _ => rs.0.draw_mesh_frame(band, buf, frame),
+                }
+                .unwrap();
             }
-            None => bands(&mut |band, buf, turn| match (alternate, turn) {
-                (true, 1) => one(&mut r2, band, buf, &frame),
-                (true, 2) => one(&mut r3, band, buf, &frame),
-                _ => one(&mut r, band, buf, &frame),
-            }),
+        }
+        let rs = (&mut r, &mut r2, &mut r3);
+        match cache {
+            Some(c) => bands(&mut drawer(&frame.with_plane_cache(c), rs, alternate)),
+            None => bands(&mut drawer(&frame, rs, alternate)),
         }
         let mut calls = crate::raster::T_AT_SNAPPED_CALLS.with(|c| c.take());
         let n = calls.len();
