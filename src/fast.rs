@@ -553,10 +553,13 @@ fn walk<const UP: bool, S: FreshSeed, D: DrawTarget, const COARSE: bool>(
                 if !maybe {
                     continue;
                 }
-                // Pixel k: a fresh reciprocal and the real test.
+                // Pixel k: a fresh reciprocal and the real test. The slope only where a chained loop may start from
+                // it: on this binade, or upward on the next, where the renormalised step halves (downward it doubles).
                 let tau = (v >> 32) as u32;
                 x = fresh::<UP, S>(tau);
-                dx = slope::<UP>(x, (dv >> 32) as i32);
+                if chain || (UP && chains::<UP, S>(dv >> 1)) {
+                    dx = slope::<UP>(x, (dv >> 32) as i32);
+                }
                 let c = b.code(x);
                 if c < row[k] {
                     row[k] = c;
