@@ -2,10 +2,11 @@
 //! buffer a firmware sends to its display over SPI or DMA, band by band or whole.
 //!
 //! Any embedded-graphics `DrawTarget` takes the draws; this one is for when the pixels live in RAM anyway. The
-//! rasterizer hands its colour to the target as one `fill_solid` a run of passing pixels, and a small triangle's
-//! runs are a few pixels long, so what that call costs counts: here a run under 16 pixels is a bounds check and a
-//! store per pixel, inline in the draw, and a longer one is filled a 32-bit word at a time, out of line. (A general target's `fill_solid` clips a rectangle of any height; embedded-graphics'
-//! own `Framebuffer` has a size fixed at compile time, no band offset, and draws a rectangle pixel by pixel.)
+//! rasterizer hands its colour to the target as one `fill_solid` a run of passing pixels, and a small triangle's runs
+//! are a few pixels long, so what that call costs counts: here a run under 16 pixels is a bounds check and a store per
+//! pixel, inline in the draw, and a longer one is filled a 32-bit word at a time, out of line. (A general target's
+//! `fill_solid` clips a rectangle of any height; embedded-graphics' own `Framebuffer` has a size fixed at compile time,
+//! no band offset, and draws a rectangle pixel by pixel.)
 
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::geometry::{Dimensions, Point, Size};
