@@ -343,7 +343,7 @@ pub(crate) fn wmul(a: i32, w: u64) -> u64 {
 
 /// The Cortex-M0 (ARMv6-M, which has no 32-bit atomics either): no 32 x 32 -> 64 multiply, and a variable 64-bit
 /// shift is a library call (`__aeabi_llsl`/`__aeabi_llsr`, some 15 instructions and a call each).
-pub(crate) const NO_WIDE: bool = cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
+const NO_WIDE: bool = cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
 
 /// `v << s` for `s < 64` (the bits shifted out lost): in 32-bit pieces on the Cortex-M0 ([`NO_WIDE`]), where
 /// set-up code shifts by a variable amount a dozen times a triangle; the 64-bit shift elsewhere.

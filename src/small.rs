@@ -60,7 +60,6 @@ use crate::edge::{flat_rows, Edge, Fixed, Side, Sub};
 use crate::fast::FAST_MAX_REL_ERROR;
 use crate::fast::{
     bits64 as bits, fresh61, lz_small, mul_hi, mul_wide, shl64, shr64, smul_wide, wmul, FreshSeed,
-    NO_WIDE,
 };
 use crate::raster::{rows_of, Setup, Stats, SUBPIXEL_BITS};
 use crate::state::{Cull, RenderState};
@@ -186,40 +185,38 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
     // pixel's column is at least `ox` (its centre is right of `xmin >= 256 ox`). The edge functions (less their
     // top-left bias) at the same centre, for the scan.
     let cy = ((j0 - oy) << SUBPIXEL_BITS) + 128;
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    let (mut sr, mut sx, mut sy) = (0u64, 0u64, 0u64);
     // Three arrays rather than the `Scan` filled in place (a zeroed struct: a `memclr` call on the Cortex-M0).
     let (mut e, mut ex, mut ey) = ([0i32; 3], [0i32; 3], [0i32; 3]);
-    // `S` at the origin and its steps, and `2A T'_max` and `2A T'_min` (exact: `bits(2A) + bits(T'_max) <= 63`).
-    let (sr, sx, sy, s_max, s_min);
-    if NO_WIDE {
-        let mut er = [0i32; 3];
-        for k in 0..3 {
-            let (a, c) = (q[k], q[(k + 1) % 3]);
-            let (ea, eb) = (a.1 - c.1, c.0 - a.0);
-            er[k] = ea * (128 - a.0) + eb * (cy - a.1); // |E| < 2^28 (module doc)
-            let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0))); // 0 on a top or left edge
-            (e[k], ex[k], ey[k]) = (er[k] - bias, ea << SUBPIXEL_BITS, eb << SUBPIXEL_BITS);
+    // The Cortex-M0 (no 32 x 32 -> 64 multiply) takes `S` by differences ([`s_by_differences`]), the other cores
+    // the sum of the three products in the loop; chosen by `cfg`, not by a constant's branch (with the M0's code
+    // present but not taken, LLVM allocated this function's registers differently on RV32: W3 +1.6%).
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    let mut er_m0 = [0i32; 3];
+    for k in 0..3 {
+        let (a, c) = (q[k], q[(k + 1) % 3]);
+        let (ea, eb) = (a.1 - c.1, c.0 - a.0);
+        let er = ea * (128 - a.0) + eb * (cy - a.1); // |E| < 2^28 (module doc)
+        let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0))); // 0 on a top or left edge
+        (e[k], ex[k], ey[k]) = (er - bias, ea << SUBPIXEL_BITS, eb << SUBPIXEL_BITS);
+        #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+        {
+            er_m0[k] = er;
         }
-        let tp_min = tp[0].min(tp[1]).min(tp[2]);
-        (sr, sx, sy, (s_max, s_min)) =
-            s_by_differences(&er, &ex, &ey, &w, area2 as i32, tp_max, tp_min);
-    } else {
-        // The same edges, with the products modulo 2^64 (the walk wraps) in the loop, and those of `2A` where the
-        // leading zeros take them: where the 64-bit multiply is cheap, [`s_by_differences`] measured 2.3% more on the
-        // Cortex-M4's W3 (register allocation, not arithmetic), and this order what it was before.
-        let (mut r, mut x, mut y) = (0u64, 0u64, 0u64);
-        for k in 0..3 {
-            let (a, c) = (q[k], q[(k + 1) % 3]);
-            let (ea, eb) = (a.1 - c.1, c.0 - a.0);
-            let er = ea * (128 - a.0) + eb * (cy - a.1);
-            let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0)));
-            (e[k], ex[k], ey[k]) = (er - bias, ea << SUBPIXEL_BITS, eb << SUBPIXEL_BITS);
-            r = r.wrapping_add(wmul(er, w[k]));
-            x = x.wrapping_add(wmul(ex[k], w[k]));
-            y = y.wrapping_add(wmul(ey[k], w[k]));
+        // The products modulo 2^64 (the walk wraps).
+        #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+        {
+            sr = sr.wrapping_add(wmul(er, w[k]));
+            sx = sx.wrapping_add(wmul(ex[k], w[k]));
+            sy = sy.wrapping_add(wmul(ey[k], w[k]));
         }
-        (sr, sx, sy) = (r, x, y);
-        (s_max, s_min) = (0, 0); // taken below
     }
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    let (sr, sx, sy, (s_max, s_min)) = {
+        let tp_min = tp[0].min(tp[1]).min(tp[2]);
+        s_by_differences(&er_m0, &ex, &ey, &w, area2 as i32, tp_max, tp_min)
+    };
     let scan = Scan {
         e,
         ex,
@@ -228,15 +225,21 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
     };
     // Every covered pixel's `S 2^sh` lies between its values at the smallest and the largest vertex `T'` (a convex
     // combination): where those two have the same leading zeros, so has every pixel, and the loop takes them once.
-    let lz_of = |s: u64| lz_small((shl64(s, sh) >> 32) as u32);
-    let (s_max, s_min) = if NO_WIDE {
-        (s_max, s_min)
-    } else {
-        let tp_min = tp[0].min(tp[1]).min(tp[2]);
-        (wmul(area2 as i32, tp_max), wmul(area2 as i32, tp_min))
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    let tp_min = tp[0].min(tp[1]).min(tp[2]);
+    // `2A T'` below 2^63 (`bits(2A) + bits(T'_max) <= 63`), so the wrapping product is exact; `2A < 2^29`.
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    let (lz, same) = {
+        let lz_of = |t: u64| lz_small((shl64(wmul(area2 as i32, t), sh) >> 32) as u32);
+        let lz = lz_of(tp_max);
+        (lz, lz_of(tp_min) == lz)
     };
-    let lz = lz_of(s_max);
-    let same = lz_of(s_min) == lz;
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    let (lz, same) = {
+        let lz_of = |s: u64| lz_small((shl64(s, sh) >> 32) as u32);
+        let lz = lz_of(s_max);
+        (lz, lz_of(s_min) == lz)
+    };
     // Where the leading zeros are the same, `S` is walked pre-shifted by them too ([`Walk::rows`]), in the same
     // shift: `sh + lz <= 30 + 8` (`sh <= 63 - 1 - 32`, and `S 2^sh >= 2^55` leaves at most 8 leading zeros).
     let shift = sh + if same { lz } else { 0 };
@@ -558,7 +561,12 @@ impl Walk {
 /// all three products, from six products of an `i32` and a difference in `(-2^36, 0]` and two of `2A` (which the
 /// leading zeros need anyway), eight against eleven. Where the differences fit an `i32` (`T'_max - T'_min < 2^31`,
 /// as a small triangle's depth mostly does), the two of `S` and one of `2A` are a [`smul_wide`] each and the four of
-/// the steps two `MULS` each. Measured on the M0: 3.1% fewer instructions on W3, 2.3% on W4.
+/// the steps two `MULS` each. Measured on the M0: 3.1% fewer instructions on W3, 2.3% on W4. (The other cores'
+/// 64-bit products are a few instructions: they keep the sum; the unit tests run this on the host.)
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+    allow(dead_code)
+)]
 #[inline(always)]
 fn s_by_differences(
     er: &[i32; 3],
