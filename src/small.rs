@@ -20,7 +20,8 @@
 //! **Depth without a plane solve.** The edge function of the edge opposite vertex `k` is `2A` (the doubled area) at
 //! vertex `k` and 0 on that edge, so `S(P) = sum_k E_opp(k)(P) T'_k = 2A T'(P)`, with `T'(P)` the barycentric
 //! interpolation of the vertices' `T'_k = round(T_k / 2^25)`. `S` is linear with integer steps: walked in wrapping
-//! `u64` it is exact at every pixel, whatever the band (no rounding of steps at all). `T'_k <= 2^36` and
+//! `u64` it is exact at every pixel, whatever the band (no rounding of steps at all); the Cortex-M0 forms its start
+//! and steps from fewer wide products, the same integers ([`s_by_differences`]). `T'_k <= 2^36` and
 //! `2A < 2^29`; the triangle is taken when `bits(2A) + bits(T'_max) <= 63`, and `S` is pre-shifted by
 //! `sh = 63 - bits(2A) - bits(T'_max)`, so every covered pixel's `S 2^sh` is below `2^63` (at least one leading zero). With `T'_min >= 2^31` (so `T_max / T_min < 32`), every covered `S` is at least `2^55`:
 //! its high word is never 0 and has at most 8 leading zeros.
