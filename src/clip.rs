@@ -13,8 +13,8 @@ use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::PixelColor;
 
 use crate::projection::Mat4;
-use crate::recip::{SpanRecip, WSpan};
-use crate::{Codec, DepthBuffer, Error, Packed, Rasterizer, Stats, Vertex};
+use crate::recip::WSpan;
+use crate::{Error, IntoDepth, Rasterizer, Stats, Vertex};
 
 /// The viewport, like D3DVIEWPORT2: the pixel rectangle (`x`, `y`, `width`, `height`; y down) that the clip
 /// rectangle of projected space (`clip_x`, `clip_y`, `clip_width`, `clip_height`; y up, D3D's default
@@ -306,41 +306,17 @@ impl<R: WSpan> Rasterizer<R> {
         Ok((planes, planes.clip(&c, codes[0] | codes[1] | codes[2])?))
     }
 
-    /// [`Rasterizer::draw_world`] into a depth buffer of any format (or none), with this rasterizer's W strategy.
-    #[allow(clippy::too_many_arguments)]
-    pub fn draw_world_format<F: Codec, D>(
-        &mut self,
-        target: &mut D,
-        mut depth: Option<&mut Packed<'_, F>>,
-        m: &Mat4,
-        vp: &Viewport,
-        p: &[[f32; 3]; 3],
-        color: D::Color,
-    ) -> Result<Stats, Error>
-    where
-        D: DrawTarget,
-        D::Color: PixelColor,
-    {
-        let (planes, poly) = self.clip_world(m, vp, p)?;
-        let mut stats = Stats::default();
-        for k in 1..poly.len().saturating_sub(1) {
-            let v = fan(&planes, &poly, k, &|_| color);
-            stats += self.draw_format(target, depth.as_deref_mut(), &v)?;
-        }
-        Ok(stats)
-    }
-}
-
-impl<R: SpanRecip> Rasterizer<R> {
     /// Draws a world-space triangle (`p` as `[x, y, z]`, transformed as row vectors `[x, y, z, 1] * m`, `m` the
-    /// world-to-clip matrix) with flat colour `color`, clipped as the module says, into a W16 buffer (the lean path),
-    /// all in f32. Errors before anything is written: [`Error::NonFinite`] for a NaN or an infinity in `p`, `m` or
-    /// `vp`, [`Error::WorldTooLarge`] when a transformed coordinate overflows f32 (any finite triangle whose clip
+    /// world-to-clip matrix) with flat colour `color`, clipped as the module says, into `depth` (a buffer of any
+    /// format, an `Option` of one, or [`NoDepth`](crate::NoDepth): as [`Rasterizer::draw`]), all in f32. Errors
+    /// before anything is written: [`Error::NonFinite`] for a NaN or an infinity in `p`, `m` or `vp`,
+    /// [`Error::WorldTooLarge`] when a transformed coordinate overflows f32 (any finite triangle whose clip
     /// coordinates stay below about `1e37` draws its visible part). A failing `target` is as [`Rasterizer::draw`]'s.
-    pub fn draw_world<D>(
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw_world<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
         &mut self,
         target: &mut D,
-        depth: &mut DepthBuffer<'_>,
+        depth: B,
         m: &Mat4,
         vp: &Viewport,
         p: &[[f32; 3]; 3],
@@ -352,9 +328,10 @@ impl<R: SpanRecip> Rasterizer<R> {
     {
         let (planes, poly) = self.clip_world(m, vp, p)?;
         let mut stats = Stats::default();
+        let mut depth = depth;
         for k in 1..poly.len().saturating_sub(1) {
             let v = fan(&planes, &poly, k, &|_| color);
-            stats += self.draw(target, depth, &v)?;
+            stats += depth.draw_triangle(self, target, &v)?;
         }
         Ok(stats)
     }

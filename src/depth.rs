@@ -1,22 +1,38 @@
 //! The packed 16-bit W-buffer: `round(W / W_far * 65535)`, the "16-bit fixed, scale 1.0" row of the format table in
 //! Rogers, "W-Buffering in Direct3D" (NVIDIA) (`W_scaled = W / W_far * scale_factor`).
 
-use crate::Error;
+use crate::format::{DepthFormat, Storage, W16};
+use crate::input::VertexInput;
+use crate::recip::WSpan;
+use crate::{Codec, DepthRange, Error, Rasterizer, Stats};
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::pixelcolor::PixelColor;
 
 /// The code of the far plane, and of a cleared buffer.
 pub const W16_FAR: u16 = u16::MAX;
 
-/// A borrowed W16 buffer covering `height` rows of a frame `width` pixels wide, from frame row `y0`
-/// (a whole frame when `y0 = 0` and `height` is the frame's height; a band otherwise).
-/// Element `(x, y)` of the frame is at `(y - y0) * width + x`.
+/// A borrowed depth buffer of format `F` (W16 unless named: the fast tier's) covering `height` rows of a frame
+/// `width` pixels wide, from frame row `y0` (a whole frame when `y0 = 0` and `height` is the frame's height; a band
+/// otherwise): one [`DepthFormat::Word`] a pixel (`u16`, `[u8; 3]` or `u32`, so 2, 3 or 4 bytes), row-major; element
+/// `(x, y)` of the frame is at `(y - y0) * width + x`. Every draw method takes one of any format (or none:
+/// [`crate::NoDepth`]); a firmware that names one format links that format's code alone.
+///
+/// ```
+/// use wraster::{format::Z24, DepthBuffer, DepthRange};
+/// let mut words = [[0u8; 3]; 64 * 16];                  // 3 bytes a pixel
+/// let mut z = DepthBuffer::<Z24>::new_format(&mut words, 64, 16)?;
+/// z.clear_for(&DepthRange::new(1.0, 100.0)?);
+/// assert_eq!(z.code(3, 4), Some(0xff_ffff));            // the far plane's Z
+/// # Ok::<(), wraster::Error>(())
+/// ```
 ///
 /// With feature `coarse`, a buffer may also keep a coarse bound (`DepthBuffer::with_bound`): for each aligned
 /// 8-pixel segment of each row, a code at least as large as every code stored in it. The fast tier's W16 span
 /// ([`crate::recip::Fast`], `Less`) rejects a whole segment whose nearest pixel is at or behind its bound before any
 /// per-pixel work.
 #[derive(Debug)]
-pub struct DepthBuffer<'a> {
-    data: &'a mut [u16],
+pub struct DepthBuffer<'a, F: DepthFormat = W16> {
+    data: &'a mut [F::Word],
     width: u16,
     height: u16,
     y0: i32,
@@ -45,14 +61,32 @@ pub const fn bound_len(width: usize, height: usize) -> usize {
     width.div_ceil(SEGMENT) * height
 }
 
-impl<'a> DepthBuffer<'a> {
-    /// A whole-frame buffer; `data.len()` must be `width * height`.
+impl<'a> DepthBuffer<'a, W16> {
+    /// A whole-frame W16 buffer; `data.len()` must be `width * height`. (Any format: [`DepthBuffer::new_format`].)
     pub fn new(data: &'a mut [u16], width: u16, height: u16) -> Result<Self, Error> {
-        Self::band(data, width, 0, height)
+        Self::band_format(data, width, 0, height)
     }
 
-    /// A band of `height` rows starting at frame row `y0`; `data.len()` must be `width * height`.
+    /// A W16 band of `height` rows starting at frame row `y0`; `data.len()` must be `width * height`. (Any format:
+    /// [`DepthBuffer::band_format`].)
     pub fn band(data: &'a mut [u16], width: u16, y0: i32, height: u16) -> Result<Self, Error> {
+        Self::band_format(data, width, y0, height)
+    }
+}
+
+impl<'a, F: Codec> DepthBuffer<'a, F> {
+    /// A whole-frame buffer of format `F`; `data.len()` must be `width * height`.
+    pub fn new_format(data: &'a mut [F::Word], width: u16, height: u16) -> Result<Self, Error> {
+        Self::band_format(data, width, 0, height)
+    }
+
+    /// A band of format `F`, `height` rows from frame row `y0`; `data.len()` must be `width * height`.
+    pub fn band_format(
+        data: &'a mut [F::Word],
+        width: u16,
+        y0: i32,
+        height: u16,
+    ) -> Result<Self, Error> {
         let expected = width as usize * height as usize;
         if data.len() != expected || width == 0 || height == 0 {
             return Err(Error::BufferSize {
@@ -73,6 +107,69 @@ impl<'a> DepthBuffer<'a> {
         })
     }
 
+    /// Sets every pixel to the far plane's code for `range` (0 for reversed Z; a W16 buffer's far code, 65535, does
+    /// not depend on the range: [`DepthBuffer::clear`]).
+    pub fn clear_for(&mut self, range: &DepthRange) {
+        let (_, fm, fe) = crate::fixed::split(range.far()).unwrap_or((false, 0, 0));
+        self.data.fill(F::Word::from_code(F::far_code((fm, fe))));
+        #[cfg(feature = "coarse")]
+        {
+            self.bound.seg.fill(W16_FAR);
+            self.bound.valid = true;
+        }
+    }
+
+    /// Frame width in pixels.
+    pub fn width(&self) -> u16 {
+        self.width
+    }
+    /// Rows held.
+    pub fn height(&self) -> u16 {
+        self.height
+    }
+    /// First frame row held.
+    pub fn y0(&self) -> i32 {
+        self.y0
+    }
+    /// The stored words, row-major.
+    pub fn data(&self) -> &[F::Word] {
+        self.data
+    }
+    /// The word at frame pixel `(x, y)`, if it is in this buffer (a W16 buffer's: the code itself).
+    pub fn get(&self, x: i32, y: i32) -> Option<F::Word> {
+        self.index(x, y).map(|k| self.data[k])
+    }
+    /// The code at frame pixel `(x, y)`, if it is in this buffer.
+    pub fn code(&self, x: i32, y: i32) -> Option<u32> {
+        self.get(x, y).map(Storage::code)
+    }
+    /// The index of frame pixel `(x, y)` in the data, if it is in this buffer.
+    fn index(&self, x: i32, y: i32) -> Option<usize> {
+        let r = y.checked_sub(self.y0)?;
+        if x < 0 || x >= self.width as i32 || r < 0 || r >= self.height as i32 {
+            return None;
+        }
+        Some(r as usize * self.width as usize + x as usize)
+    }
+    /// The word of frame pixel `(x, y)`, to write, if it is in this buffer.
+    #[inline]
+    pub(crate) fn pixel_mut(&mut self, x: i32, y: i32) -> Option<&mut F::Word> {
+        let k = self.index(x, y)?;
+        self.data.get_mut(k)
+    }
+    /// The stored words, row-major, to write.
+    #[inline]
+    pub(crate) fn data_mut(&mut self) -> &mut [F::Word] {
+        self.data
+    }
+    #[inline]
+    pub(crate) fn row_mut(&mut self, y: i32) -> &mut [F::Word] {
+        let r = (y - self.y0) as usize * self.width as usize;
+        &mut self.data[r..r + self.width as usize]
+    }
+}
+
+impl<'a> DepthBuffer<'a, W16> {
     /// Keeps a coarse bound in `seg` (feature `coarse`), whose length must be [`bound_len`]`(width, height)`. It
     /// starts at the far code, which bounds any content; [`DepthBuffer::clear`] resets it, and the W16 draws lower it
     /// as they write. The frames and codes are the same with and without it: it only skips work.
@@ -115,41 +212,6 @@ impl<'a> DepthBuffer<'a> {
         }
     }
 
-    /// Frame width in pixels.
-    pub fn width(&self) -> u16 {
-        self.width
-    }
-    /// Rows held.
-    pub fn height(&self) -> u16 {
-        self.height
-    }
-    /// First frame row held.
-    pub fn y0(&self) -> i32 {
-        self.y0
-    }
-    /// The stored codes, row-major.
-    pub fn data(&self) -> &[u16] {
-        self.data
-    }
-    /// The code at frame pixel `(x, y)`, if it is in this buffer.
-    pub fn get(&self, x: i32, y: i32) -> Option<u16> {
-        let r = y.checked_sub(self.y0)?;
-        if x < 0 || x >= self.width as i32 || r < 0 || r >= self.height as i32 {
-            return None;
-        }
-        Some(self.data[r as usize * self.width as usize + x as usize])
-    }
-    /// The stored codes, row-major, to write.
-    #[inline]
-    pub(crate) fn data_mut(&mut self) -> &mut [u16] {
-        self.data
-    }
-    #[inline]
-    pub(crate) fn row_mut(&mut self, y: i32) -> &mut [u16] {
-        let r = (y - self.y0) as usize * self.width as usize;
-        &mut self.data[r..r + self.width as usize]
-    }
-
     /// A draw with `cmp` (and depth write `write`) may raise stored codes: stop using the coarse bound until the
     /// next clear.
     #[inline(always)]
@@ -182,6 +244,104 @@ impl<'a> DepthBuffer<'a> {
             &mut []
         };
         (row, seg)
+    }
+}
+
+/// What a draw method takes for depth: a buffer of any format (`&mut DepthBuffer<F>`), an `Option` of one, or
+/// [`NoDepth`] (depth off: the rows and columns drawn are then the colour target's). One draw method per primitive
+/// takes any of them; the format decides the loop (a W16 buffer with a per-pixel reciprocal: the fast tier's).
+pub trait IntoDepth<'b, 'a: 'b> {
+    /// The buffer's format ([`W16`] for [`NoDepth`], which stores nothing).
+    type Format: Codec;
+    /// The buffer, if any.
+    fn into_depth(self) -> Option<&'b mut DepthBuffer<'a, Self::Format>>;
+    /// [`crate::Rasterizer::draw`] of one triangle into it (the format's loops: [`Codec::draw_into`]), or with depth
+    /// off. A method of this trait, so that a draw into a buffer instantiates no depth-off path, and one with depth
+    /// off no format's.
+    #[doc(hidden)]
+    fn draw_triangle<R: WSpan, D, V>(
+        &mut self,
+        r: &mut Rasterizer<R>,
+        target: &mut D,
+        v: &[V; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+        V: VertexInput<Color = D::Color>;
+}
+
+impl<'b, 'a: 'b, F: Codec> IntoDepth<'b, 'a> for &'b mut DepthBuffer<'a, F> {
+    type Format = F;
+    #[inline(always)]
+    fn into_depth(self) -> Option<&'b mut DepthBuffer<'a, F>> {
+        Some(self)
+    }
+    #[inline(always)]
+    fn draw_triangle<R: WSpan, D, V>(
+        &mut self,
+        r: &mut Rasterizer<R>,
+        target: &mut D,
+        v: &[V; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+        V: VertexInput<Color = D::Color>,
+    {
+        F::draw_into(r, target, self, v)
+    }
+}
+
+impl<'b, 'a: 'b, F: Codec> IntoDepth<'b, 'a> for Option<&'b mut DepthBuffer<'a, F>> {
+    type Format = F;
+    #[inline(always)]
+    fn into_depth(self) -> Option<&'b mut DepthBuffer<'a, F>> {
+        self
+    }
+    #[inline(always)]
+    fn draw_triangle<R: WSpan, D, V>(
+        &mut self,
+        r: &mut Rasterizer<R>,
+        target: &mut D,
+        v: &[V; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+        V: VertexInput<Color = D::Color>,
+    {
+        match self {
+            Some(d) => F::draw_into(r, target, d, v),
+            None => r.draw_packed::<F, D>(target, None, v),
+        }
+    }
+}
+
+/// No depth buffer: depth off, every covered pixel in the depth range drawn, in the colour target's rows and
+/// columns.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NoDepth;
+
+impl IntoDepth<'static, 'static> for NoDepth {
+    type Format = W16;
+    #[inline(always)]
+    fn into_depth(self) -> Option<&'static mut DepthBuffer<'static, W16>> {
+        None
+    }
+    #[inline(always)]
+    fn draw_triangle<R: WSpan, D, V>(
+        &mut self,
+        r: &mut Rasterizer<R>,
+        target: &mut D,
+        v: &[V; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+        V: VertexInput<Color = D::Color>,
+    {
+        r.draw_packed::<W16, D>(target, None, v)
     }
 }
 

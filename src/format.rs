@@ -8,12 +8,57 @@
 //! Dunlop, "Linear Depth" (linear Z, `z * w / far`), and Direct3D's `[0, 1]` Z, `Z = f / (f - n) * (1 - n / d)`.
 //! `n`, `f` are `W_near`, `W_far`; `d` is eye depth. Depths outside `[n, f]` saturate to the end codes.
 
+/// One pixel's storage in a depth buffer: `u16` (2-byte formats), `[u8; 3]` (3-byte formats, little-endian, no
+/// padding) or `u32` (4-byte formats). A [`crate::DepthBuffer`] of format `F` borrows a slice of `F::Word`.
+pub trait Storage: Copy + Default + PartialEq + core::fmt::Debug {
+    /// The word holding `code` (below `2^(8 BYTES)`).
+    fn from_code(code: u32) -> Self;
+    /// The code this word holds.
+    fn code(self) -> u32;
+}
+
+impl Storage for u16 {
+    #[inline(always)]
+    fn from_code(code: u32) -> Self {
+        code as u16
+    }
+    #[inline(always)]
+    fn code(self) -> u32 {
+        self as u32
+    }
+}
+
+impl Storage for [u8; 3] {
+    #[inline(always)]
+    fn from_code(code: u32) -> Self {
+        let b = code.to_le_bytes();
+        [b[0], b[1], b[2]]
+    }
+    #[inline(always)]
+    fn code(self) -> u32 {
+        u32::from_le_bytes([self[0], self[1], self[2], 0])
+    }
+}
+
+impl Storage for u32 {
+    #[inline(always)]
+    fn from_code(code: u32) -> Self {
+        code
+    }
+    #[inline(always)]
+    fn code(self) -> u32 {
+        self
+    }
+}
+
 /// A depth storage format.
 pub trait DepthFormat {
     /// Name, as the precision tool prints it.
     const NAME: &'static str;
     /// Bytes per pixel of packed storage.
     const BYTES: usize;
+    /// A pixel's storage: [`Storage`] of `BYTES` bytes.
+    type Word: Storage;
     /// Largest code.
     const MAX_CODE: u32;
     /// The code of eye depth `d` (round to nearest).
@@ -78,12 +123,14 @@ pub fn rz_of(d: f64, n: f64, f: f64) -> f64 {
 }
 
 macro_rules! unorm_format {
-    ($(#[$m:meta])* $t:ident, $name:literal, $bytes:literal, $max:expr, $enc:expr, $dec:expr) => {
+    ($(#[$m:meta])* $t:ident, $name:literal, $bytes:literal, $word:ty, $max:expr, $enc:expr, $dec:expr) => {
         $(#[$m])*
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
         pub struct $t;
         impl DepthFormat for $t {
             const NAME: &'static str = $name;
             const BYTES: usize = $bytes;
+            type Word = $word;
             const MAX_CODE: u32 = $max;
             fn encode(d: f64, n: f64, f: f64) -> u32 {
                 let v: fn(f64, f64, f64) -> f64 = $enc;
@@ -102,24 +149,25 @@ macro_rules! unorm_format {
 
 unorm_format!(
     /// Linear W, 16-bit unorm: `round(W / W_far * 65535)` (Rogers: "16-bit fixed, scale 1.0"). The core's format.
-    W16, "W16", 2, 0xffff, |d, _n, f| d / f, |v, _n, f| v * f
+    W16, "W16", 2, u16, 0xffff, |d, _n, f| d / f, |v, _n, f| v * f
 );
 unorm_format!(
     /// D3D Z, 16-bit unorm.
-    Z16, "Z16", 2, 0xffff, z_of, d_of_z
+    Z16, "Z16", 2, u16, 0xffff, z_of, d_of_z
 );
 unorm_format!(
     /// D3D Z, 24-bit unorm (3 bytes).
-    Z24, "Z24", 3, 0xff_ffff, z_of, d_of_z
+    Z24, "Z24", 3, [u8; 3], 0xff_ffff, z_of, d_of_z
 );
 unorm_format!(
     /// Linear Z in a 16-bit Z buffer: the value of Dunlop's "Linear Depth" `z * w / far` trick at a vertex, `(d - n) / (f - n)`.
-    LZ16, "LZ16", 2, 0xffff, |d, n, f| (d - n) / (f - n), |v, n, f| n + v * (f - n)
+    LZ16, "LZ16", 2, u16, 0xffff, |d, n, f| (d - n) / (f - n), |v, n, f| n + v * (f - n)
 );
 
 /// The 16-bit float W of Rogers's table ("16-bit floating point, scale 2^8"): unsigned E4M12 (4-bit exponent,
 /// bias 7, 12-bit mantissa, implicit one; largest value 511.9375), storing `W / W_far * 2^8`. Values below the
 /// smallest normal, `2^-6`, are denormals (`m / 4096 * 2^-6`): with `f / n <= 2^14` every depth is normal.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct W16F;
 
 impl W16F {
@@ -144,6 +192,7 @@ fn pow2(e: i32) -> f64 {
 impl DepthFormat for W16F {
     const NAME: &'static str = "W16F";
     const BYTES: usize = 2;
+    type Word = u16;
     const MAX_CODE: u32 = 0xffff;
     fn encode(d: f64, n: f64, f: f64) -> u32 {
         let v = clamp_d(d, n, f) / f * 256.0;
@@ -175,11 +224,13 @@ fn f24_value(code: u32) -> f64 {
 
 /// The 24-bit float W (the DDK's "W-Buffering": an IEEE single without its low mantissa byte, 3 bytes), W stored directly
 /// (Rogers's first option: "load the W value in directly", losing the low mantissa bits).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct W24F;
 
 impl DepthFormat for W24F {
     const NAME: &'static str = "W24F";
     const BYTES: usize = 3;
+    type Word = [u8; 3];
     const MAX_CODE: u32 = 0x7f_7fff;
     fn encode(d: f64, n: f64, f: f64) -> u32 {
         f24_of(clamp_d(d, n, f))
@@ -193,11 +244,13 @@ impl DepthFormat for W24F {
 }
 
 /// The 24-bit float W scaled by `2^127 / W_far` (Rogers's second option), so the far plane is `2^127`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct W24FScaled;
 
 impl DepthFormat for W24FScaled {
     const NAME: &'static str = "W24F-scaled";
     const BYTES: usize = 3;
+    type Word = [u8; 3];
     const MAX_CODE: u32 = 0x7f_7fff;
     fn encode(d: f64, n: f64, f: f64) -> u32 {
         f24_of(clamp_d(d, n, f) / f * pow2(127))
@@ -211,11 +264,13 @@ impl DepthFormat for W24FScaled {
 }
 
 /// IEEE single W (the DDK's "W-Buffering" 32-bit format), 4 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct W32F;
 
 impl DepthFormat for W32F {
     const NAME: &'static str = "W32F";
     const BYTES: usize = 4;
+    type Word = u32;
     const MAX_CODE: u32 = 0x7f7f_ffff;
     fn encode(d: f64, n: f64, f: f64) -> u32 {
         (clamp_d(d, n, f) as f32).to_bits()
@@ -229,11 +284,13 @@ impl DepthFormat for W32F {
 }
 
 /// IEEE single D3D Z, 4 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Z32F;
 
 impl DepthFormat for Z32F {
     const NAME: &'static str = "Z32F";
     const BYTES: usize = 4;
+    type Word = u32;
     const MAX_CODE: u32 = 0x3f80_0000;
     fn encode(d: f64, n: f64, f: f64) -> u32 {
         (z_of(clamp_d(d, n, f), n, f) as f32).to_bits()
@@ -247,11 +304,13 @@ impl DepthFormat for Z32F {
 }
 
 /// Reversed float Z (near 1, far 0; compare reversed), the modern baseline: IEEE single of `n (f/d - 1) / (f - n)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RZ32F;
 
 impl DepthFormat for RZ32F {
     const NAME: &'static str = "RZ32F";
     const BYTES: usize = 4;
+    type Word = u32;
     const MAX_CODE: u32 = 0x3f80_0000;
     fn encode(d: f64, n: f64, f: f64) -> u32 {
         (rz_of(clamp_d(d, n, f), n, f) as f32).to_bits()
@@ -382,11 +441,24 @@ mod tests {
         check::<W32F>(23);
     }
 
-    /// Packed storage is 2, 3 or 4 bytes and round-trips every code's low bytes.
+    /// Packed storage is 2, 3 or 4 bytes and round-trips every code's low bytes; a buffer's word (`F::Word`) is
+    /// `BYTES` bytes and holds every code, whose little-endian bytes are the ones `pack` writes.
     #[test]
     fn packing() {
         fn check<F: DepthFormat>(bytes: usize) {
             assert_eq!(F::BYTES, bytes);
+            assert_eq!(core::mem::size_of::<F::Word>(), bytes);
+            for c in [0, 1, 0x5a, F::MAX_CODE / 3, F::MAX_CODE - 1, F::MAX_CODE] {
+                let w = F::Word::from_code(c);
+                assert_eq!(w.code(), c);
+                let mut b = [0u8; 4];
+                F::pack(c, &mut b);
+                let mem = match bytes {
+                    2 => (w.code() as u16).to_le_bytes().to_vec(),
+                    _ => w.code().to_le_bytes()[..bytes].to_vec(),
+                };
+                assert_eq!(&mem[..], &b[..bytes], "{} {c}", F::NAME);
+            }
             for c in [0, 1, F::MAX_CODE / 3, F::MAX_CODE - 1, F::MAX_CODE] {
                 let mut b = [0xAAu8; 4];
                 F::pack(c, &mut b);

@@ -30,14 +30,15 @@
 //! # Ok::<(), wraster::Error>(())
 //! ```
 //!
-//! Any depth format of the seeds ([`format`]) renders through [`Packed`] buffers, with Z or W buffering
-//! ([`DepthMode`]), and points, lines and wireframe triangles too:
+//! Every depth format of the seeds ([`format`]) renders through the same [`DepthBuffer`] type (W16 when none is
+//! named) and the same draw methods, with Z or W buffering ([`DepthMode`]), and points, lines and wireframe triangles
+//! too; [`NoDepth`] draws with depth off:
 //!
 //! ```
 //! use embedded_graphics_core::pixelcolor::Rgb565;
 //! use embedded_graphics_core::prelude::*;
 //! use wraster::format::RZ32F;
-//! use wraster::{DepthMode, Packed, Rasterizer, RenderState, Vertex};
+//! use wraster::{DepthBuffer, DepthMode, NoDepth, Rasterizer, RenderState, Vertex};
 //!
 //! # struct Screen;
 //! # impl OriginDimensions for Screen { fn size(&self) -> Size { Size::new(32, 16) } }
@@ -47,15 +48,16 @@
 //! # }
 //! let mut state = RenderState::new(10.0, 1000.0)?;
 //! state.mode = DepthMode::Z;
-//! let mut bytes = [0u8; 32 * 16 * 4];
-//! let mut depth = Packed::<RZ32F>::new(&mut bytes, 32, 16)?; // reversed float Z, 4 bytes a pixel
-//! depth.clear(&state.range);
+//! let mut words = [0u32; 32 * 16];
+//! let mut depth = DepthBuffer::<RZ32F>::new_format(&mut words, 32, 16)?; // reversed float Z, 4 bytes a pixel
+//! depth.clear_for(&state.range);
 //! let mut r: Rasterizer = Rasterizer::new(state);
 //! let a = Vertex::new(1.5, 1.5, 20.0, Rgb565::RED);
 //! let b = Vertex::new(30.5, 4.5, 900.0, Rgb565::RED);
 //! let c = Vertex::new(6.5, 14.5, 100.0, Rgb565::RED);
-//! assert!(r.draw_format(&mut Screen, Some(&mut depth), &[a, b, c])?.written > 100);
-//! assert!(r.draw_line_format(&mut Screen, Some(&mut depth), &[a, b])?.fragments > 20);
+//! assert!(r.draw(&mut Screen, &mut depth, &[a, b, c])?.written > 100);
+//! assert!(r.draw_line(&mut Screen, &mut depth, &[a, b])?.fragments > 20);
+//! assert!(r.draw_point(&mut Screen, NoDepth, &c)?.written == 1);
 //! # Ok::<(), wraster::Error>(())
 //! ```
 //!
@@ -139,10 +141,10 @@ pub(crate) fn xorshift(mut s: u64) -> impl FnMut() -> u64 + Copy {
 
 #[cfg(feature = "coarse")]
 pub use depth::bound_len;
-pub use depth::{DepthBuffer, DepthStore, W16_FAR};
+pub use depth::{DepthBuffer, DepthStore, IntoDepth, NoDepth, W16_FAR};
 pub use error::Error;
 pub use input::{FixedVertex, VertexInput};
-pub use packed::{Codec, Packed, Resolved};
+pub use packed::{Codec, Resolved};
 pub use raster::{
     depth_grid_bits, row_range, Rasterizer, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS,
 };

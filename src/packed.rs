@@ -10,16 +10,16 @@
 //!   `(W - n) / (f - n)` exactly and interpolates it linearly in screen space, as the hardware interpolates any
 //!   vertex z: right at the vertices, wrong inside (the error the seed does not mention, shown by the tests).
 //!
-//! The W16 buffer of [`crate::DepthBuffer`] has its own lean loop ([`crate::Rasterizer::draw`]); this one serves every
-//! format with every strategy, and gives the same W16 codes (a test checks it).
-
-use core::marker::PhantomData;
+//! [`crate::Rasterizer::draw`] gives W16 buffers to the tiers' own W16 loops (where the strategy is a per-pixel
+//! reciprocal) and every other format to this loop, which serves every format with every strategy and gives the
+//! same W16 codes as those loops (a test checks it, through `Rasterizer::draw_generic`).
 
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::PixelColor;
 use embedded_graphics_core::prelude::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 
+use crate::depth::IntoDepth;
 use crate::edge::Sub;
 use crate::fixed::{div_u128, split};
 use crate::format::{DepthFormat, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
@@ -30,8 +30,8 @@ use crate::raster::{div_round, Plane, Runs, Stats};
 #[cfg(feature = "bias")]
 use crate::recip::exact_u;
 use crate::recip::WSpan;
-use crate::state::{DepthMode, DepthRange};
-use crate::{Error, Rasterizer};
+use crate::state::{DepthMode, ZConst};
+use crate::{DepthBuffer, Error, Rasterizer};
 
 /// What a format's code is computed from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -45,7 +45,7 @@ pub enum Input {
 }
 
 /// A format the rasterizer can store into: the integer encoder of [`DepthFormat`]'s f64 definition.
-pub trait Codec: DepthFormat {
+pub trait Codec: DepthFormat + 'static {
     /// What the code is computed from.
     const INPUT: Input;
     /// Nearer is a larger code (reversed Z): comparisons are evaluated with their operands swapped, so `Less` still
@@ -53,6 +53,25 @@ pub trait Codec: DepthFormat {
     const REVERSED: bool = false;
     /// The code of `q` (in [`Codec::INPUT`]'s units, at most its far-plane value) with `W_far = far.0 * 2^far.1`.
     fn code(q: u64, far: (u32, i32)) -> u32;
+    /// [`crate::Rasterizer::draw`] of one triangle into a buffer of this format: the span loop generic over the
+    /// format and the strategy, except for W16, whose draws take the strategy's own W16 loops
+    /// ([`WSpan::draw_w16`]). Resolved at compile time, so a firmware links only its format's loops.
+    #[doc(hidden)]
+    #[inline(always)]
+    fn draw_into<R: WSpan, D, V>(
+        r: &mut Rasterizer<R>,
+        target: &mut D,
+        depth: &mut DepthBuffer<'_, Self>,
+        v: &[V; 3],
+    ) -> Result<Stats, Error>
+    where
+        Self: Sized,
+        D: DrawTarget,
+        D::Color: PixelColor,
+        V: VertexInput<Color = D::Color>,
+    {
+        r.draw_packed(target, Some(depth), v)
+    }
     /// The code of the far plane, which a cleared buffer holds.
     fn far_code(far: (u32, i32)) -> u32 {
         Self::code(Self::far_q(), far)
@@ -107,6 +126,20 @@ fn w_of(u: u64, far: (u32, i32)) -> (u64, i32) {
 
 impl Codec for W16 {
     const INPUT: Input = Input::W;
+    #[inline(always)]
+    fn draw_into<R: WSpan, D, V>(
+        r: &mut Rasterizer<R>,
+        target: &mut D,
+        depth: &mut DepthBuffer<'_, W16>,
+        v: &[V; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+        V: VertexInput<Color = D::Color>,
+    {
+        R::draw_w16(r, target, depth, v)
+    }
     #[inline(always)]
     fn code(u: u64, _far: (u32, i32)) -> u32 {
         unorm_code(u, 62, 0xffff)
@@ -198,53 +231,6 @@ impl Codec for LZ16 {
     }
 }
 
-/// `n / (f - n)` as `k / 2^s` with `k` in `[2^31, 2^33)` (truncated: relative error below `2^-31`), for the reversed
-/// Z `rz = (t - 1) n / (f - n)`.
-#[derive(Clone, Copy)]
-pub(crate) struct ZConst {
-    k: u64,
-    s: i32,
-}
-
-impl ZConst {
-    pub(crate) fn new(range: &DepthRange) -> Self {
-        // Both are positive and finite (checked by DepthRange).
-        let (_, nm, ne) = split(range.near()).unwrap_or((false, 1, 0));
-        let (_, fm, fe) = split(range.far()).unwrap_or((false, 2, 0));
-        let e = ne.min(fe);
-        // f / n <= 2^30 and both mantissas are below 2^24, so the aligned values stay below 2^(24 + 30 + 24).
-        let nv = (nm as u128) << (ne - e).min(100);
-        let fv = (fm as u128) << (fe - e).min(100);
-        let d = (fv - nv).max(1);
-        let bits = |v: u128| 128 - v.leading_zeros() as i32;
-        let s = 32 + bits(d) - bits(nv);
-        let k = if s >= 0 {
-            (nv << s as u32) / d
-        } else {
-            (nv >> (-s) as u32) / d
-        };
-        ZConst { k: k as u64, s }
-    }
-    /// `rz * 2^60` of `T = t 2^frac` (signed: negative beyond the far plane), saturated to `[-2^62, 2^62]`.
-    #[inline(always)]
-    pub(crate) fn rz60(&self, t: u64, frac: u32) -> i64 {
-        let d = t as i128 - (1i128 << frac);
-        let p = d * self.k as i128; // |d| < 2^62, k < 2^33
-        let sh = self.s + frac as i32 - 60;
-        let v = if sh >= 0 {
-            p >> sh.min(127)
-        } else {
-            p << (-sh).min(40)
-        };
-        v.clamp(-(1 << 62), 1 << 62) as i64
-    }
-    /// D3D Z in Q0.60 of a pixel in range (`t` in `[1, f/n]`).
-    #[inline(always)]
-    pub(crate) fn z60(&self, t: u64, frac: u32) -> u64 {
-        ((1i64 << 60) - self.rz60(t, frac)).clamp(0, 1 << 60) as u64
-    }
-}
-
 /// The linear-Z trick's value `(W - n) / (f - n) = Z * u` at a vertex (exact `u`), Q0.60, saturated to `+-2^61` so
 /// vertices beyond the range still give a plane (pixels outside the range are not drawn).
 fn linear_z60(zc: &ZConst, t: i64, frac: u32) -> i64 {
@@ -253,85 +239,6 @@ fn linear_z60(zc: &ZConst, t: i64, frac: u32) -> i64 {
     // |z| < 2^63 (rz60 is saturated to 2^62) and u <= 2^64 after the clamp, so the product fits i128
     let u = div_u128((1u128 << (62 + frac).min(125)) + (t as u128 >> 1), t).min(1 << 64) as i128;
     ((z * u) >> 62).clamp(-(1 << 61), 1 << 61) as i64
-}
-
-/// A borrowed depth buffer of format `F`: `width * height` pixels of `F::BYTES` bytes, little-endian, row-major,
-/// covering frame rows `y0 ..`. The layout the frame's pixel `(x, y)` has is bytes `((y - y0) * width + x) * BYTES ..`.
-pub struct Packed<'a, F> {
-    data: &'a mut [u8],
-    width: u16,
-    height: u16,
-    y0: i32,
-    _f: PhantomData<F>,
-}
-
-impl<'a, F: Codec> Packed<'a, F> {
-    /// A whole-frame buffer; `data.len()` must be `width * height * F::BYTES`.
-    pub fn new(data: &'a mut [u8], width: u16, height: u16) -> Result<Self, Error> {
-        Self::band(data, width, 0, height)
-    }
-    /// A band of `height` rows from frame row `y0`; `data.len()` must be `width * height * F::BYTES`.
-    pub fn band(data: &'a mut [u8], width: u16, y0: i32, height: u16) -> Result<Self, Error> {
-        let expected = width as usize * height as usize * F::BYTES;
-        if data.len() != expected || width == 0 || height == 0 {
-            return Err(Error::BufferSize {
-                expected,
-                actual: data.len(),
-            });
-        }
-        Ok(Packed {
-            data,
-            width,
-            height,
-            y0,
-            _f: PhantomData,
-        })
-    }
-    /// Sets every pixel to the far plane's code for `range` (0 for reversed Z).
-    pub fn clear(&mut self, range: &DepthRange) {
-        let (_, fm, fe) = split(range.far()).unwrap_or((false, 0, 0));
-        let far = F::far_code((fm, fe));
-        for px in self.data.chunks_exact_mut(F::BYTES) {
-            F::pack(far, px);
-        }
-    }
-    /// Frame width in pixels.
-    pub fn width(&self) -> u16 {
-        self.width
-    }
-    /// Rows held.
-    pub fn height(&self) -> u16 {
-        self.height
-    }
-    /// First frame row held.
-    pub fn y0(&self) -> i32 {
-        self.y0
-    }
-    /// The packed bytes.
-    pub fn data(&self) -> &[u8] {
-        self.data
-    }
-    /// The code at frame pixel `(x, y)`, if it is in this buffer.
-    pub fn get(&self, x: i32, y: i32) -> Option<u32> {
-        let k = self.offset(x, y)?;
-        Some(F::unpack(&self.data[k..k + F::BYTES]))
-    }
-    fn pixel_mut(&mut self, x: i32, y: i32) -> Option<&mut [u8]> {
-        let k = self.offset(x, y)?;
-        Some(&mut self.data[k..k + F::BYTES])
-    }
-    /// The byte offset of frame pixel `(x, y)`, if it is in this buffer.
-    fn offset(&self, x: i32, y: i32) -> Option<usize> {
-        let r = y.checked_sub(self.y0)?;
-        if x < 0 || x >= self.width as i32 || r < 0 || r >= self.height as i32 {
-            return None;
-        }
-        Some((r as usize * self.width as usize + x as usize) * F::BYTES)
-    }
-    fn row_mut(&mut self, y: i32, lo: i32, hi: i32) -> &mut [u8] {
-        let r = (y - self.y0) as usize * self.width as usize;
-        &mut self.data[(r + lo as usize) * F::BYTES..(r + hi as usize) * F::BYTES]
-    }
 }
 
 /// The depth buffering a draw gets after Dunlop's "Using W-Buffers" capability check (see [`DepthMode`]).
@@ -381,10 +288,10 @@ impl<R: WSpan> Rasterizer<R> {
     /// Draws one flat-coloured triangle into `target` and a depth buffer of any format (or none: depth off; the rows
     /// and columns are then the target's). The depth test runs before any colour work for the pixel (the Windows CE "Depth Buffering" docs): a
     /// passing pixel's colour is sent with its run. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_format<F: Codec, D>(
+    pub(crate) fn draw_packed<F: Codec, D>(
         &mut self,
         target: &mut D,
-        mut depth: Option<&mut Packed<'_, F>>,
+        mut depth: Option<&mut DepthBuffer<'_, F>>,
         v: &[impl VertexInput<Color = D::Color>; 3],
     ) -> Result<Stats, Error>
     where
@@ -428,7 +335,7 @@ impl<R: WSpan> Rasterizer<R> {
                 let t0 = w.t.at(off) as u64;
                 let mut runs = Runs::new(target, lo, j, color);
                 if let (Some(buf), true) = (depth.as_deref_mut(), res.mode != DepthMode::Off) {
-                    let row = buf.row_mut(j, lo, hi);
+                    let row = &mut buf.row_mut(j)[lo as usize..hi as usize];
                     let z0 = lin.map_or(0, |p| p.at(off));
                     let dz = lin.map_or(0, |p| p.sx);
                     let line = Line1 {
@@ -438,7 +345,7 @@ impl<R: WSpan> Rasterizer<R> {
                         dz,
                     };
                     codes::<F, R, Error>(&mut self.recip, &ctx, &line, n, |k, code| {
-                        let px = &mut row[k * F::BYTES..(k + 1) * F::BYTES];
+                        let px = &mut row[k];
                         match code {
                             Some(c) if ctx.test::<F>(px, c) => Ok(()),
                             _ => runs.fail(k),
@@ -523,16 +430,17 @@ impl<R: WSpan> Rasterizer<R> {
 /// triangle's depth bias, in its first vertex's colour.
 impl<R: WSpan> Rasterizer<R> {
     /// Draws one point. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_point_format<F: Codec, D>(
+    pub fn draw_point<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
         &mut self,
         target: &mut D,
-        depth: Option<&mut Packed<'_, F>>,
+        depth: B,
         v: &impl VertexInput<Color = D::Color>,
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
         D::Color: PixelColor,
     {
+        let depth = depth.into_depth();
         let s = self.setup(core::array::from_ref(v))?;
         let z = linear_z60(&self.zconst(), s.t[0], s.frac);
         let line = Line1 {
@@ -542,22 +450,23 @@ impl<R: WSpan> Rasterizer<R> {
             dz: 0,
         };
         let at = |_k: usize| (s.p[0].x >> 8, s.p[0].y >> 8);
-        self.pixels::<F, D>(target, depth, &line, 1, at, 0, s.frac, v.color())
+        self.pixels::<B::Format, D>(target, depth, &line, 1, at, 0, s.frac, v.color())
     }
 
     /// Draws one line from `v[0]` to `v[1]` (flat, `v[0]`'s colour). On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_line_format<F: Codec, D>(
+    pub fn draw_line<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
         &mut self,
         target: &mut D,
-        depth: Option<&mut Packed<'_, F>>,
+        depth: B,
         v: &[impl VertexInput<Color = D::Color>; 2],
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
         D::Color: PixelColor,
     {
+        let depth = depth.into_depth();
         let s = self.setup(v)?;
-        self.line_inner::<F, D>(
+        self.line_inner::<B::Format, D>(
             target,
             depth,
             (s.p[0], s.p[1]),
@@ -570,16 +479,17 @@ impl<R: WSpan> Rasterizer<R> {
 
     /// Draws the three edges of a triangle, culled like a solid one, with its depth bias. On an error nothing is
     /// written.
-    pub fn draw_wireframe_format<F: Codec, D>(
+    pub fn draw_wireframe<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
         &mut self,
         target: &mut D,
-        mut depth: Option<&mut Packed<'_, F>>,
+        depth: B,
         v: &[impl VertexInput<Color = D::Color>; 3],
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
         D::Color: PixelColor,
     {
+        let mut depth = depth.into_depth();
         let s = self.setup(v)?;
         let [p0, p1, p2] = s.p;
         let area = (p1.x - p0.x) as i64 * (p2.y - p0.y) as i64
@@ -598,10 +508,10 @@ impl<R: WSpan> Rasterizer<R> {
         }
         let range = (1u64 << s.frac, self.state.range.t_max(s.frac));
         let zc = self.zconst();
-        let bias = self.format_bias::<F>(&zc, &s.p, &s.t, s.frac, range);
+        let bias = self.format_bias::<B::Format>(&zc, &s.p, &s.t, s.frac, range);
         let mut stats = Stats::default();
         for (a, b) in [(0, 1), (1, 2), (2, 0)] {
-            stats += self.line_inner::<F, D>(
+            stats += self.line_inner::<B::Format, D>(
                 target,
                 depth.as_deref_mut(),
                 (s.p[a], s.p[b]),
@@ -618,7 +528,7 @@ impl<R: WSpan> Rasterizer<R> {
     fn line_inner<F: Codec, D>(
         &mut self,
         target: &mut D,
-        depth: Option<&mut Packed<'_, F>>,
+        depth: Option<&mut DepthBuffer<'_, F>>,
         (a, b): (Sub, Sub),
         (ta, tb): (i64, i64),
         frac: u32,
@@ -699,7 +609,7 @@ impl<R: WSpan> Rasterizer<R> {
     fn pixels<F: Codec, D>(
         &mut self,
         target: &mut D,
-        depth: Option<&mut Packed<'_, F>>,
+        depth: Option<&mut DepthBuffer<'_, F>>,
         line: &Line1,
         n: usize,
         at: impl Fn(usize) -> (i32, i32),
@@ -774,9 +684,12 @@ impl<R: WSpan> Rasterizer<R> {
 }
 
 /// The rows (first, count) and columns a draw covers: the buffer's, or the target's without one.
-fn extent<F, D: DrawTarget>(depth: &Option<&mut Packed<'_, F>>, target: &D) -> (i32, u16, u16) {
+fn extent<F: Codec, D: DrawTarget>(
+    depth: &Option<&mut DepthBuffer<'_, F>>,
+    target: &D,
+) -> (i32, u16, u16) {
     match depth {
-        Some(d) => (d.y0, d.height, d.width),
+        Some(d) => (d.y0(), d.height(), d.width()),
         None => {
             let b = target.bounding_box();
             let w = (b.top_left.x.max(0) as u32 + b.size.width).min(u16::MAX as u32);
@@ -804,16 +717,16 @@ struct DepthCtx {
 impl DepthCtx {
     /// The depth test of one pixel's stored bytes against `code` (biased), writing on a pass when enabled.
     #[inline(always)]
-    fn test<F: Codec>(&self, px: &mut [u8], code: u32) -> bool {
+    fn test<F: Codec>(&self, px: &mut F::Word, code: u32) -> bool {
         let c = biased::<F>(code, self.bias);
-        let stored = F::unpack(px);
+        let stored = crate::format::Storage::code(*px);
         let pass = if F::REVERSED {
             self.cmp.test(stored, c)
         } else {
             self.cmp.test(c, stored)
         };
         if pass && self.write {
-            F::pack(c, px);
+            *px = crate::format::Storage::from_code(c);
         }
         pass
     }
@@ -928,7 +841,7 @@ mod float_bits_tests {
 
 #[cfg(test)]
 mod zconst_tests {
-    use super::ZConst;
+    use crate::state::ZConst;
     use crate::DepthRange;
 
     /// `rz60` is `(t - 1) n / (f - n) 2^60` within the constant's truncation (`2^-31` relative) and the final shift's
@@ -976,10 +889,10 @@ mod zconst_tests {
 
 #[cfg(test)]
 mod code_tests {
-    use super::Packed;
-    use crate::format::{DepthFormat, W16F, W32F};
+    use crate::format::{DepthFormat, Storage, W16F, W32F};
     use crate::raster::{Rasterizer, Vertex};
     use crate::recip::Fast;
+    use crate::DepthBuffer;
     use crate::{Codec, RenderState};
     use embedded_graphics_core::pixelcolor::BinaryColor;
     use embedded_graphics_core::prelude::{DrawTarget, OriginDimensions, Pixel, Size};
@@ -1010,9 +923,9 @@ mod code_tests {
     fn a_flat_triangle_stores_its_exact_w() {
         fn check<F: Codec + DepthFormat>() {
             let state = RenderState::new(1.0, 64.0).unwrap();
-            let mut bytes = vec![0u8; 32 * 32 * F::BYTES];
-            let mut buf = Packed::<F>::new(&mut bytes, 32, 32).unwrap();
-            buf.clear(&state.range);
+            let mut words = vec![F::Word::default(); 32 * 32];
+            let mut buf = DepthBuffer::<F>::new_format(&mut words, 32, 32).unwrap();
+            buf.clear_for(&state.range);
             let on = BinaryColor::On;
             let t = [
                 Vertex::new(1.0, 1.0, 16.0, on),
@@ -1020,10 +933,10 @@ mod code_tests {
                 Vertex::new(3.0, 29.0, 16.0, on),
             ];
             let stats = Rasterizer::<Fast>::new(state)
-                .draw_format(&mut Sink, Some(&mut buf), &t)
+                .draw(&mut Sink, &mut buf, &t)
                 .unwrap();
             let mut n = 0;
-            for c in bytes.chunks_exact(F::BYTES).map(F::unpack) {
+            for c in words.iter().map(|w| w.code()) {
                 let v = F::fraction(c, 1.0, 64.0);
                 if v != 1.0 {
                     assert_eq!(v, 0.25, "{}: code {c}", F::NAME);

@@ -462,6 +462,24 @@ pub trait WSpan: Default {
         hi: u64,
         px: impl FnMut(usize, Option<u64>) -> Result<(), E>,
     ) -> Result<(), E>;
+
+    /// [`crate::Rasterizer::draw`] into a W16 buffer with this strategy: the span loop generic over the format,
+    /// unless the strategy is a per-pixel reciprocal ([`SpanRecip`]), whose W16 draws take the lean loops.
+    #[doc(hidden)]
+    #[inline(always)]
+    fn draw_w16<D>(
+        r: &mut crate::Rasterizer<Self>,
+        target: &mut D,
+        depth: &mut crate::DepthBuffer<'_>,
+        v: &[impl crate::VertexInput<Color = D::Color>; 3],
+    ) -> Result<crate::Stats, crate::Error>
+    where
+        Self: Sized,
+        D: embedded_graphics_core::draw_target::DrawTarget,
+        D::Color: embedded_graphics_core::pixelcolor::PixelColor,
+    {
+        r.draw_packed(target, Some(depth), v)
+    }
 }
 
 /// Both ends of the span in `[lo, hi]`, so every pixel is (`T` is linear along it).
@@ -474,6 +492,19 @@ fn ends_in(t0: u64, dt: i64, n: usize, lo: u64, hi: u64) -> bool {
 impl<R: SpanRecip> WSpan for R {
     const INTEGER_TRANSFORM: bool = R::INTEGER_TRANSFORM;
     const NAME: &'static str = R::NAME;
+    #[inline(always)]
+    fn draw_w16<D>(
+        r: &mut crate::Rasterizer<Self>,
+        target: &mut D,
+        depth: &mut crate::DepthBuffer<'_>,
+        v: &[impl crate::VertexInput<Color = D::Color>; 3],
+    ) -> Result<crate::Stats, crate::Error>
+    where
+        D: embedded_graphics_core::draw_target::DrawTarget,
+        D::Color: embedded_graphics_core::pixelcolor::PixelColor,
+    {
+        r.draw_memo(target, depth, v, &mut crate::raster::NoMemo)
+    }
     #[inline(always)]
     fn walk<E>(
         &mut self,

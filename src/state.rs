@@ -199,6 +199,53 @@ impl RenderState {
     }
 }
 
+/// `n / (f - n)` as `k / 2^s` with `k` in `[2^31, 2^33)` (truncated: relative error below `2^-31`), for the reversed
+/// Z `rz = (t - 1) n / (f - n)`.
+#[derive(Clone, Copy)]
+pub(crate) struct ZConst {
+    k: u64,
+    s: i32,
+}
+
+impl ZConst {
+    pub(crate) fn new(range: &DepthRange) -> Self {
+        // Both are positive and finite (checked by DepthRange).
+        let (_, nm, ne) = split(range.near()).unwrap_or((false, 1, 0));
+        let (_, fm, fe) = split(range.far()).unwrap_or((false, 2, 0));
+        let e = ne.min(fe);
+        // f / n <= 2^30 and both mantissas are below 2^24, so the aligned values stay below 2^(24 + 30 + 24).
+        let nv = (nm as u128) << (ne - e).min(100);
+        let fv = (fm as u128) << (fe - e).min(100);
+        let d = (fv - nv).max(1);
+        let bits = |v: u128| 128 - v.leading_zeros() as i32;
+        let s = 32 + bits(d) - bits(nv);
+        let k = if s >= 0 {
+            (nv << s as u32) / d
+        } else {
+            (nv >> (-s) as u32) / d
+        };
+        ZConst { k: k as u64, s }
+    }
+    /// `rz * 2^60` of `T = t 2^frac` (signed: negative beyond the far plane), saturated to `[-2^62, 2^62]`.
+    #[inline(always)]
+    pub(crate) fn rz60(&self, t: u64, frac: u32) -> i64 {
+        let d = t as i128 - (1i128 << frac);
+        let p = d * self.k as i128; // |d| < 2^62, k < 2^33
+        let sh = self.s + frac as i32 - 60;
+        let v = if sh >= 0 {
+            p >> sh.min(127)
+        } else {
+            p << (-sh).min(40)
+        };
+        v.clamp(-(1 << 62), 1 << 62) as i64
+    }
+    /// D3D Z in Q0.60 of a pixel in range (`t` in `[1, f/n]`).
+    #[inline(always)]
+    pub(crate) fn z60(&self, t: u64, frac: u32) -> u64 {
+        ((1i64 << 60) - self.rz60(t, frac)).clamp(0, 1 << 60) as u64
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -151,7 +151,7 @@ fn plans() {
     writeln!(s, "/// Whether a plan draws W4's torus (its vertices need RAM).\npub const HAS_TORUS: bool = false{};", torus.iter().map(|t| format!(" || {t}")).collect::<String>()).unwrap();
     writeln!(
         s,
-        "/// The `u16` words of depth storage a board gives the plans.\npub const DEPTH_LEN: usize = MAX_DEPTH_RAM.div_ceil(2);\n/// The transformed vertices a board stores for the plans (the torus's, or none).\npub const VERTS_LEN: usize = if HAS_TORUS {{ wraster::scenes::torus::VERTICES }} else {{ 0 }};\n/// The row bins a board stores for the plans (a byte per torus triangle, or none).\npub const BINS_LEN: usize = if HAS_TORUS {{ wraster::scenes::torus::TRIANGLES }} else {{ 0 }};"
+        "/// The `u32` words of depth storage a board gives the plans (4-byte words, so that a 4-byte format's buffer is\n/// aligned; [`crate::u16_words`] lends them as `u16`s).\npub const DEPTH_LEN: usize = MAX_DEPTH_RAM.div_ceil(4);\n/// The transformed vertices a board stores for the plans (the torus's, or none).\npub const VERTS_LEN: usize = if HAS_TORUS {{ wraster::scenes::torus::VERTICES }} else {{ 0 }};\n/// The row bins a board stores for the plans (a byte per torus triangle, or none).\npub const BINS_LEN: usize = if HAS_TORUS {{ wraster::scenes::torus::TRIANGLES }} else {{ 0 }};"
     )
     .unwrap();
     writeln!(

@@ -10,14 +10,14 @@ use super::{Bytes, Canvas, Guarded};
 use embedded_graphics_core::pixelcolor::Rgb565;
 use embedded_graphics_core::prelude::Size;
 use wraster::clip::Viewport;
-use wraster::format::{W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
+use wraster::format::{Storage, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
 use wraster::input::{I24F8, U16F16, U1F31, U8F24};
 use wraster::mesh::{Colors, Mesh, PlaneCache, Projected};
 use wraster::projection::{self, Camera, Mat4};
 use wraster::recip::{Exact, Fast, Linear, Newton, PerPixel, PrevPixel, Quake, SpanRecip, WSpan};
 use wraster::{
-    Codec, Compare, Cull, DepthBuffer, DepthMode, DepthRange, Error, FixedVertex, Packed,
-    Rasterizer, RenderState, Stats, Vertex, VertexInput,
+    Codec, Compare, Cull, DepthBuffer, DepthMode, DepthRange, Error, FixedVertex, Rasterizer,
+    RenderState, Stats, Vertex, VertexInput,
 };
 
 const COMPARES: [Compare; 8] = [
@@ -302,7 +302,7 @@ fn raster_with<R: SpanRecip>(b: &mut Bytes) {
 }
 
 // ---------------------------------------------------------------------------------------------------------------
-// packed: every format, mode and primitive through `Packed` buffers (or none).
+// packed: every format, mode and primitive through `DepthBuffer`s of every format (or none).
 
 pub fn packed(data: &[u8]) {
     let mut b = Bytes(data);
@@ -350,30 +350,34 @@ fn packed_with<F: Codec, R: WSpan>(b: &mut Bytes) {
         })
         .collect();
     let off = b.u8() as usize % 5;
-    if off != 2 && n * F::BYTES + off >= 2 {
-        let mut v = vec![0u8; n * F::BYTES + off - 2];
+    if off != 2 && n + off >= 2 {
+        let mut v = vec![F::Word::default(); n + off - 2];
         assert!(matches!(
-            Packed::<F>::new(&mut v, w, h),
+            DepthBuffer::<F>::new_format(&mut v, w, h),
             Err(Error::BufferSize { .. })
         ));
     }
     let draw = |r: &mut Rasterizer<R>,
                 c: &mut Canvas,
-                d: Option<&mut Packed<F>>,
+                d: Option<&mut DepthBuffer<F>>,
                 p: Prim,
                 t: &[Vertex<Rgb565>; 3]| match p {
-        Prim::Tri => r.draw_format(c, d, t),
-        Prim::Line => r.draw_line_format(c, d, &[t[0], t[1]]),
-        Prim::Point => r.draw_point_format(c, d, &t[0]),
-        Prim::Wire => r.draw_wireframe_format(c, d, t),
+        Prim::Tri => r.draw(c, d, t),
+        Prim::Line => r.draw_line(c, d, &[t[0], t[1]]),
+        Prim::Point => r.draw_point(c, d, &t[0]),
+        Prim::Wire => r.draw_wireframe(c, d, t),
     };
-    let bytes = n * F::BYTES;
+    let (fill, s1, s2) = (
+        F::Word::default(),
+        F::Word::from_code(0xa5a5_a5a5),
+        F::Word::from_code(0x5a5a_5a5a),
+    );
     let mut r = Rasterizer::<R>::new(st);
     let mut canvas = Canvas::new(w as u32, h as u32);
-    let mut depth = Guarded::new(bytes, 0u8, 0xa5);
-    Packed::<F>::new(depth.inner(), w, h)
+    let mut depth = Guarded::new(n, fill, s1);
+    DepthBuffer::<F>::new_format(depth.inner(), w, h)
         .unwrap()
-        .clear(&st.range);
+        .clear_for(&st.range);
     let mut whole = Vec::new();
     for (p, t) in &ops {
         let (c0, d0) = (canvas.clone(), depth.data().to_vec());
@@ -383,7 +387,7 @@ fn packed_with<F: Codec, R: WSpan>(b: &mut Bytes) {
             draw(
                 &mut r,
                 &mut canvas,
-                Some(&mut Packed::<F>::new(depth.inner(), w, h).unwrap()),
+                Some(&mut DepthBuffer::<F>::new_format(depth.inner(), w, h).unwrap()),
                 *p,
                 t,
             )
@@ -396,17 +400,17 @@ fn packed_with<F: Codec, R: WSpan>(b: &mut Bytes) {
     }
     if !no_depth {
         let mut canvas2 = Canvas::new(w as u32, h as u32);
-        let mut depth2 = Guarded::new(bytes, 0u8, 0x5a);
-        Packed::<F>::new(depth2.inner(), w, h)
+        let mut depth2 = Guarded::new(n, fill, s2);
+        DepthBuffer::<F>::new_format(depth2.inner(), w, h)
             .unwrap()
-            .clear(&st.range);
+            .clear_for(&st.range);
         for ((p, t), want) in ops.iter().zip(&whole) {
             let mut sum = Ok(Stats::default());
             for y0 in (0..h).step_by(band as usize) {
                 let hh = band.min(h - y0);
-                let row = w as usize * F::BYTES;
+                let row = w as usize;
                 let rows = &mut depth2.inner()[y0 as usize * row..(y0 + hh) as usize * row];
-                let mut buf = Packed::<F>::band(rows, w, y0 as i32, hh).unwrap();
+                let mut buf = DepthBuffer::<F>::band_format(rows, w, y0 as i32, hh).unwrap();
                 add(&mut sum, draw(&mut r, &mut canvas2, Some(&mut buf), *p, t));
             }
             depth2.check();
@@ -417,10 +421,10 @@ fn packed_with<F: Codec, R: WSpan>(b: &mut Bytes) {
     }
     let mut canvas3 = Canvas::new(w as u32, h as u32);
     canvas3.budget = Some(b.u16() as u32 % 512);
-    let mut depth3 = Guarded::new(bytes, 0u8, 0x5a);
-    Packed::<F>::new(depth3.inner(), w, h)
+    let mut depth3 = Guarded::new(n, fill, s2);
+    DepthBuffer::<F>::new_format(depth3.inner(), w, h)
         .unwrap()
-        .clear(&st.range);
+        .clear_for(&st.range);
     failing_matches(&whole, |k| {
         let (p, t) = &ops[k];
         if no_depth {
@@ -429,7 +433,7 @@ fn packed_with<F: Codec, R: WSpan>(b: &mut Bytes) {
             draw(
                 &mut r,
                 &mut canvas3,
-                Some(&mut Packed::<F>::new(depth3.inner(), w, h).unwrap()),
+                Some(&mut DepthBuffer::<F>::new_format(depth3.inner(), w, h).unwrap()),
                 *p,
                 t,
             )
@@ -648,19 +652,19 @@ pub fn world(data: &[u8]) {
         mcanvas.same_picture(&mcanvas2) && mdepth.data() == mdepth2.data(),
         "mesh: bands differ"
     );
-    // The same triangle in a packed Z format (draw_world_format), and a failing target.
+    // The same triangle in a packed Z format (draw_world), and a failing target.
     let mut zst = st;
     zst.mode = DepthMode::Z;
     let mut rz: Rasterizer<Exact> = Rasterizer::new(zst);
     let mut zc = Canvas::new(w as u32, h as u32);
-    let mut zd = Guarded::new(n * 3, 0u8, 0xa5);
-    Packed::<Z24>::new(zd.inner(), w, h)
+    let mut zd = Guarded::new(n, [0u8; 3], [0xa5; 3]);
+    DepthBuffer::<Z24>::new_format(zd.inner(), w, h)
         .unwrap()
-        .clear(&zst.range);
+        .clear_for(&zst.range);
     let z0 = zd.data().to_vec();
-    let zres = rz.draw_world_format(
+    let zres = rz.draw_world(
         &mut zc,
-        Some(&mut Packed::<Z24>::new(zd.inner(), w, h).unwrap()),
+        Some(&mut DepthBuffer::<Z24>::new_format(zd.inner(), w, h).unwrap()),
         &m,
         &vp,
         &tri,
@@ -827,9 +831,9 @@ pub fn state_target(data: &[u8]) {
             Err(e) => assert!(!ok || w == 0 || h == 0, "{e:?}"),
         }
     }
-    let mut bytes = vec![0u8; len];
-    let ok3 = len == w as usize * h as usize * 3;
-    match Packed::<W24F>::band(&mut bytes, w, y0, h) {
+    let mut bytes = vec![[0u8; 3]; len];
+    let ok3 = len == w as usize * h as usize;
+    match DepthBuffer::<W24F>::band_format(&mut bytes, w, y0, h) {
         Ok(_) => assert!(ok3),
         Err(e) => assert!(!ok3 || w == 0 || h == 0, "{e:?}"),
     }
@@ -984,13 +988,13 @@ fn fixed_with<R: wraster::input::Fixed<Bits = u32>>(b: &mut Bytes) {
                 "{e:?}"
             );
         }
-        let mut pa = Guarded::new(n * 2, 0u8, 0xa5);
-        Packed::<Z16>::new(pa.inner(), w, h)
+        let mut pa = Guarded::new(n, 0u16, 0xa5a5);
+        DepthBuffer::<Z16>::new_format(pa.inner(), w, h)
             .unwrap()
-            .clear(&st.range);
-        let pra = r.draw_format(
+            .clear_for(&st.range);
+        let pra = r.draw(
             &mut ca,
-            Some(&mut Packed::<Z16>::new(pa.inner(), w, h).unwrap()),
+            Some(&mut DepthBuffer::<Z16>::new_format(pa.inner(), w, h).unwrap()),
             &fx,
         );
         pa.check();
@@ -1004,13 +1008,13 @@ fn fixed_with<R: wraster::input::Fixed<Bits = u32>>(b: &mut Bytes) {
                 &fl,
             );
             assert_eq!(ra, rb, "{fx:?} / {fl:?}");
-            let mut pb = Guarded::new(n * 2, 0u8, 0xa5);
-            Packed::<Z16>::new(pb.inner(), w, h)
+            let mut pb = Guarded::new(n, 0u16, 0xa5a5);
+            DepthBuffer::<Z16>::new_format(pb.inner(), w, h)
                 .unwrap()
-                .clear(&st.range);
-            let prb = r.draw_format(
+                .clear_for(&st.range);
+            let prb = r.draw(
                 &mut cb,
-                Some(&mut Packed::<Z16>::new(pb.inner(), w, h).unwrap()),
+                Some(&mut DepthBuffer::<Z16>::new_format(pb.inner(), w, h).unwrap()),
                 &fl,
             );
             assert_eq!(pra, prb);

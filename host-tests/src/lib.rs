@@ -14,10 +14,10 @@ pub mod plot;
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::*;
 use embedded_graphics::primitives::Rectangle;
-use wraster::format::DepthFormat;
+use wraster::format::{DepthFormat, Storage};
 use wraster::packed::Input;
 use wraster::recip::{SpanRecip, WSpan};
-use wraster::{Codec, DepthBuffer, Error, Packed, Rasterizer, RenderState, Stats, Vertex};
+use wraster::{Codec, DepthBuffer, Error, Rasterizer, RenderState, Stats, Vertex};
 
 /// A colour framebuffer that counts writes per pixel and panics on any write outside it.
 #[derive(Clone, PartialEq, Eq, Debug)]
@@ -354,7 +354,7 @@ pub fn render<R: SpanRecip>(
     let stats = in_bands(&mut depth, w, h, band_h, |buf| {
         let mut stats = Stats::default();
         for t in tris {
-            stats += r.draw(&mut frame, buf, t)?;
+            stats += r.draw(&mut frame, &mut *buf, t)?;
         }
         Ok(stats)
     })?;
@@ -447,8 +447,17 @@ pub fn random_tri(rng: &mut Rng, wmin: f64, wmax: f64) -> [Vertex<Rgb565>; 3] {
     v
 }
 
+/// `words`' codes as the little-endian bytes of their format's storage, `F::BYTES` each.
+pub fn le_bytes<F: DepthFormat>(words: &[F::Word]) -> Vec<u8> {
+    words
+        .iter()
+        .flat_map(|w| w.code().to_le_bytes()[..F::BYTES].to_vec())
+        .collect()
+}
+
 /// Renders `tris` into a `w x h` frame and a whole-frame buffer of format `F` (cleared to the far plane) with
-/// strategy `R`; returns the frame, every pixel's code and the summed stats.
+/// strategy `R`, through the span loop generic over the format (W16's too: `Rasterizer::draw_generic`); returns the
+/// frame, every pixel's code and the summed stats.
 pub fn render_format<F: Codec, R: WSpan>(
     tris: &[[Vertex<Rgb565>; 3]],
     state: RenderState,
@@ -456,15 +465,16 @@ pub fn render_format<F: Codec, R: WSpan>(
     h: u16,
 ) -> Result<(Frame, Vec<u32>, Stats), Error> {
     let mut frame = Frame::new(w as u32, h as u32);
-    let mut bytes = vec![0u8; w as usize * h as usize * F::BYTES];
-    let mut buf = Packed::<F>::new(&mut bytes, w, h)?;
-    buf.clear(&state.range);
+    let mut words = vec![F::Word::default(); w as usize * h as usize];
+    let mut buf = DepthBuffer::<F>::new_format(&mut words, w, h)?;
+    buf.clear_for(&state.range);
     let mut r = Rasterizer::<R>::new(state);
     let mut stats = Stats::default();
     for t in tris {
-        stats += r.draw_format(&mut frame, Some(&mut buf), t)?;
+        // The span loop generic over the format, W16's too (`draw` gives W16 to the tiers' own loops).
+        stats += r.draw_generic(&mut frame, &mut buf, t)?;
     }
-    let codes = bytes.chunks_exact(F::BYTES).map(F::unpack).collect();
+    let codes = words.iter().map(|w| w.code()).collect();
     Ok((frame, codes, stats))
 }
 

@@ -9,9 +9,9 @@
 //! from the vertices as given, in f64, with the scene's own depth range.
 //!
 //! The candidates, cheapest first:
-//! - **no depth buffer**: culling and drawing order alone (`draw_format` with no buffer);
+//! - **no depth buffer**: culling and drawing order alone (`draw` with `NoDepth`);
 //! - the 16-bit formats (2 bytes a pixel): W16 through the lean path (`Rasterizer::draw`, the fast tier), then
-//!   LZ16, Z16 and W16F through `draw_format`; then the 24-bit (W24F, W24FScaled, Z24) and 32-bit (W32F, Z32F,
+//!   LZ16, Z16 and W16F through the generic span loop; then the 24-bit (W24F, W24FScaled, Z24) and 32-bit (W32F, Z32F,
 //!   RZ32F) ones;
 //! - for each format the W strategies in the order of their measured cost on the core (the boards' `bench` lines in
 //!   the README: on the M4 and RV32 `fast-div`, `fast`, `exact`, `prev-pixel`; on the M0, whose division is a
@@ -34,7 +34,7 @@ use wraster::format::{
     DepthFormat, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F,
 };
 use wraster::recip::{Exact, Fast, FastDiv, PrevPixel, SpanRecip};
-use wraster::{Codec, Cull, Error, Packed, Rasterizer, RenderState, Vertex};
+use wraster::{Codec, Cull, DepthBuffer, Error, NoDepth, Rasterizer, RenderState, Vertex};
 
 use crate::{in_bands, reference_tri, snap, Frame};
 
@@ -421,7 +421,7 @@ fn draw_as<R: SpanRecip>(
             let mut frame = Frame::new(w as u32, h as u32);
             let mut r = Rasterizer::<R>::new(state);
             for t in tris {
-                r.draw_format::<W16, _>(&mut frame, None, t)?;
+                r.draw(&mut frame, NoDepth, t)?;
             }
             Ok(frame)
         }
@@ -432,7 +432,7 @@ fn draw_as<R: SpanRecip>(
             in_bands(&mut depth, w, h, band_h, |buf| {
                 let mut s = wraster::Stats::default();
                 for t in tris {
-                    s += r.draw(&mut frame, buf, t)?;
+                    s += r.draw(&mut frame, &mut *buf, t)?;
                 }
                 Ok(s)
             })?;
@@ -904,7 +904,7 @@ fn plan_hash_as<R: SpanRecip>(plan: &Plan) -> Result<(u64, u32, u32), Error> {
         let depth_rows: Vec<Vec<u8>> = match plan.format.as_str() {
             "none" => {
                 for t in tris {
-                    stats += r.draw_format::<W16, _>(&mut frame, None, t)?;
+                    stats += r.draw(&mut frame, NoDepth, t)?;
                 }
                 vec![vec![]; h]
             }
@@ -925,7 +925,7 @@ fn plan_hash_as<R: SpanRecip>(plan: &Plan) -> Result<(u64, u32, u32), Error> {
                     stats += crate::in_bands_bounded(&mut depth, ww, hh, rows, &mut seg, |buf| {
                         let mut s = wraster::Stats::default();
                         for t in tris {
-                            s += r.draw(&mut frame, buf, t)?;
+                            s += r.draw(&mut frame, &mut *buf, t)?;
                         }
                         Ok(s)
                     })?;
@@ -978,13 +978,13 @@ fn packed_rows<R: SpanRecip>(
         let mut y0 = 0u16;
         while y0 < h {
             let bh = band_h.min(h - y0);
-            let mut bytes = vec![0u8; w as usize * bh as usize * F::BYTES];
-            let mut buf = Packed::<F>::band(&mut bytes, w, y0 as i32, bh)?;
-            buf.clear(&state.range);
+            let mut words = vec![F::Word::default(); w as usize * bh as usize];
+            let mut buf = DepthBuffer::<F>::band_format(&mut words, w, y0 as i32, bh)?;
+            buf.clear_for(&state.range);
             for t in tris {
-                stats += r.draw_format(&mut frame, Some(&mut buf), t)?;
+                stats += r.draw(&mut frame, &mut buf, t)?;
             }
-            rows.extend(bytes.chunks(w as usize * F::BYTES).map(<[u8]>::to_vec));
+            rows.extend(words.chunks(w as usize).map(crate::le_bytes::<F>));
             y0 += bh;
         }
         Ok((frame, rows, stats))

@@ -320,7 +320,7 @@ fn max_t_is_the_limit_the_checks_apply() {
     );
 }
 
-/// A band may start at any row `y0` (`DepthBuffer::band`, `Packed::band` take any `i32`): bands at the ends of the
+/// A band may start at any row `y0` (`DepthBuffer::band`, `band_format` take any `i32`): bands at the ends of the
 /// `i32` range, where `y0 + height` would overflow, draw nothing and do not panic, through the triangle paths (small
 /// and general), a packed format's triangles, lines and points, a world triangle and a mesh frame binned and not.
 #[test]
@@ -328,7 +328,7 @@ fn bands_at_the_ends_of_the_row_range_draw_nothing() {
     use wraster::clip::Viewport;
     use wraster::format::W24F;
     use wraster::mesh::{Colors, Mesh, Projected};
-    use wraster::Packed;
+    use wraster::DepthBuffer;
     let cam = host_tests::cube_camera();
     let (pos, idx) = host_tests::cube();
     let mesh = Mesh {
@@ -385,21 +385,21 @@ fn bands_at_the_ends_of_the_row_range_draw_nothing() {
                 .written,
             0
         );
-        let mut bytes = vec![0u8; 64 * 8 * 3];
-        let mut packed = Packed::<W24F>::band(&mut bytes, 64, y0, 8).unwrap();
+        let mut bytes = vec![[0u8; 3]; 64 * 8];
+        let mut packed = DepthBuffer::<W24F>::band_format(&mut bytes, 64, y0, 8).unwrap();
         for tri in [good(), big] {
-            let s = r.draw_format(&mut frame, Some(&mut packed), &tri).unwrap();
+            let s = r.draw(&mut frame, Some(&mut packed), &tri).unwrap();
             assert_eq!(s.written, 0, "y0 {y0}");
         }
         let line = [good()[0], good()[2]];
         assert_eq!(
-            r.draw_line_format(&mut frame, Some(&mut packed), &line)
+            r.draw_line(&mut frame, Some(&mut packed), &line)
                 .unwrap()
                 .written,
             0
         );
         assert_eq!(
-            r.draw_point_format(&mut frame, Some(&mut packed), &good()[1])
+            r.draw_point(&mut frame, Some(&mut packed), &good()[1])
                 .unwrap()
                 .written,
             0

@@ -227,7 +227,7 @@ fn bias_applies_to_small_triangles() {
     }
 }
 
-/// The packed formats take the bias too (`draw_format`): a constant bias of `k` codes moves every stored code by
+/// The other formats take the bias too (the generic span loop): a constant bias of `k` codes moves every stored code by
 /// exactly `k` (none saturates here: the triangle lies well inside the range), and a slope-scaled bias alone moves
 /// every code of a sloped triangle by the same positive amount (its `m` times the scale, one offset per triangle).
 #[test]

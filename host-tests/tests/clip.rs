@@ -375,13 +375,13 @@ fn bad_world_input_is_an_error_and_writes_nothing() {
     assert!(frame.writes.iter().all(|&n| n == 0));
 }
 
-/// World space into any format: the packed path draws the same pixels and W16 codes as the lean one, for triangles
-/// crossing the near plane and lying partly behind the eye, and the Z formats get the same coverage.
+/// World space into any format: a W16 buffer given directly or as an `Option` draws the same pixels and codes, for
+/// triangles crossing the near plane and lying partly behind the eye, and the Z formats get the same coverage.
 #[test]
 fn world_triangles_into_any_format() {
     use wraster::format::{W16, Z16};
     use wraster::recip::{DefaultRecip, PerPixel};
-    use wraster::Packed;
+    use wraster::DepthBuffer;
     let m = projection();
     let vp = Viewport::new(0.0, 0.0, W as f32, H as f32);
     let tris = [
@@ -403,29 +403,27 @@ fn world_triangles_into_any_format() {
         let a = r
             .draw_world(&mut lean_frame, &mut buf, &m, &vp, &t, Rgb565::WHITE)
             .unwrap();
+        // The same buffer type given as an `Option` takes the same loop.
         let mut frame = Frame::new(W as u32, H as u32);
-        let mut bytes = vec![0u8; W as usize * H as usize * 2];
-        let mut pbuf = Packed::<W16>::new(&mut bytes, W, H).unwrap();
-        pbuf.clear(&state.range);
+        let mut words = vec![0u16; W as usize * H as usize];
+        let mut pbuf = DepthBuffer::<W16>::new_format(&mut words, W, H).unwrap();
+        pbuf.clear_for(&state.range);
         let b = r
-            .draw_world_format(&mut frame, Some(&mut pbuf), &m, &vp, &t, Rgb565::WHITE)
+            .draw_world(&mut frame, Some(&mut pbuf), &m, &vp, &t, Rgb565::WHITE)
             .unwrap();
         assert_eq!(a, b);
         assert!(a.written > 100);
         assert!(frame == lean_frame);
-        assert!(depth
-            .iter()
-            .zip(bytes.chunks_exact(2))
-            .all(|(d, b)| *d == u16::from_le_bytes([b[0], b[1]])));
+        assert!(depth == words);
         let mut zstate = state;
         zstate.mode = wraster::DepthMode::Z;
         let mut rz: Rasterizer<PerPixel<DefaultRecip>> = Rasterizer::new(zstate);
         let mut zframe = Frame::new(W as u32, H as u32);
-        let mut zbytes = vec![0u8; W as usize * H as usize * 2];
-        let mut zbuf = Packed::<Z16>::new(&mut zbytes, W, H).unwrap();
-        zbuf.clear(&state.range);
+        let mut zwords = vec![0u16; W as usize * H as usize];
+        let mut zbuf = DepthBuffer::<Z16>::new_format(&mut zwords, W, H).unwrap();
+        zbuf.clear_for(&state.range);
         let c = rz
-            .draw_world_format(&mut zframe, Some(&mut zbuf), &m, &vp, &t, Rgb565::WHITE)
+            .draw_world(&mut zframe, Some(&mut zbuf), &m, &vp, &t, Rgb565::WHITE)
             .unwrap();
         assert_eq!(c.written, a.written);
     }

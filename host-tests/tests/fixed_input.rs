@@ -6,9 +6,7 @@ use host_tests::{random_tri, Frame, Rng};
 use wraster::format::{W24F, Z16};
 use wraster::input::{I24F8, U1F31, U8F24};
 use wraster::recip::{Exact, Fast, SpanRecip};
-use wraster::{
-    DepthBuffer, DepthMode, Error, FixedVertex, Packed, Rasterizer, RenderState, Vertex,
-};
+use wraster::{DepthBuffer, DepthMode, Error, FixedVertex, Rasterizer, RenderState, Vertex};
 
 /// The f32 vertex moved onto values both types hold exactly: x, y on the 1/256 grid, and `rhw` a multiple of 2^-31
 /// (U1F31's step) with at most 24 significant bits (an f32 mantissa). Returns the pair.
@@ -105,7 +103,7 @@ fn fixed_input_draws_like_f32_in_w16() {
     w16_pair::<Exact>(&tris, state);
 }
 
-/// Packed formats (a W and a Z format), points, lines and wireframes: identical frames, codes and stats.
+/// Other formats (a W and a Z format), points, lines and wireframes: identical frames, codes and stats.
 #[test]
 fn fixed_input_draws_like_f32_in_packed_formats_and_primitives() {
     let tris = suite();
@@ -118,50 +116,50 @@ fn fixed_input_draws_like_f32_in_packed_formats_and_primitives() {
             Frame::new(W as u32, H as u32),
         );
         let n = W as usize * H as usize;
-        let (mut ba, mut bb) = (vec![0u8; n * 3], vec![0u8; n * 3]); // W24F: 3 bytes a pixel
+        let (mut ba, mut bb) = (vec![[0u8; 3]; n], vec![[0u8; 3]; n]); // W24F: 3 bytes a pixel
         let mut total = 0;
         for (a, b) in &tris {
             // Each triangle alone into cleared buffers, so no later triangle hides a difference.
-            let mut pa = Packed::<W24F>::new(&mut ba, W, H).unwrap();
-            let mut pb = Packed::<W24F>::new(&mut bb, W, H).unwrap();
-            pa.clear(&state.range);
-            pb.clear(&state.range);
+            let mut pa = DepthBuffer::<W24F>::new_format(&mut ba, W, H).unwrap();
+            let mut pb = DepthBuffer::<W24F>::new_format(&mut bb, W, H).unwrap();
+            pa.clear_for(&state.range);
+            pb.clear_for(&state.range);
             if mode == DepthMode::Z {
                 // Z formats through their own buffer type; W24F refuses Z (checked below).
-                let mut za = vec![0u8; n * 2];
-                let mut zb = vec![0u8; n * 2];
-                let mut qa = Packed::<Z16>::new(&mut za, W, H).unwrap();
-                let mut qb = Packed::<Z16>::new(&mut zb, W, H).unwrap();
-                qa.clear(&state.range);
-                qb.clear(&state.range);
-                let x = r.draw_format(&mut fa, Some(&mut qa), a);
-                let y = r.draw_format(&mut fb, Some(&mut qb), b);
+                let mut za = vec![0u16; n];
+                let mut zb = vec![0u16; n];
+                let mut qa = DepthBuffer::<Z16>::new_format(&mut za, W, H).unwrap();
+                let mut qb = DepthBuffer::<Z16>::new_format(&mut zb, W, H).unwrap();
+                qa.clear_for(&state.range);
+                qb.clear_for(&state.range);
+                let x = r.draw(&mut fa, Some(&mut qa), a);
+                let y = r.draw(&mut fb, Some(&mut qb), b);
                 assert_eq!(x, y);
                 let _ = (qa, qb);
                 let diff = za.iter().zip(&zb).filter(|(p, q)| p != q).count();
-                assert!(diff == 0, "{diff} bytes differ: {a:?} / {b:?} {x:?}");
+                assert!(diff == 0, "{diff} codes differ: {a:?} / {b:?} {x:?}");
                 total += x.map(|s| s.written).unwrap_or(0);
                 assert_eq!(
-                    r.draw_format(&mut fa, Some(&mut pa), a),
-                    r.draw_format(&mut fb, Some(&mut pb), b)
+                    r.draw(&mut fa, Some(&mut pa), a),
+                    r.draw(&mut fb, Some(&mut pb), b)
                 );
                 continue;
             }
-            let x = r.draw_format(&mut fa, Some(&mut pa), a);
-            let y = r.draw_format(&mut fb, Some(&mut pb), b);
+            let x = r.draw(&mut fa, Some(&mut pa), a);
+            let y = r.draw(&mut fb, Some(&mut pb), b);
             assert_eq!(x, y);
             total += x.map(|s| s.written).unwrap_or(0);
             assert_eq!(
-                r.draw_line_format(&mut fa, Some(&mut pa), &[a[0], a[1]]),
-                r.draw_line_format(&mut fb, Some(&mut pb), &[b[0], b[1]])
+                r.draw_line(&mut fa, Some(&mut pa), &[a[0], a[1]]),
+                r.draw_line(&mut fb, Some(&mut pb), &[b[0], b[1]])
             );
             assert_eq!(
-                r.draw_point_format(&mut fa, Some(&mut pa), &a[2]),
-                r.draw_point_format(&mut fb, Some(&mut pb), &b[2])
+                r.draw_point(&mut fa, Some(&mut pa), &a[2]),
+                r.draw_point(&mut fb, Some(&mut pb), &b[2])
             );
             assert_eq!(
-                r.draw_wireframe_format(&mut fa, Some(&mut pa), a),
-                r.draw_wireframe_format(&mut fb, Some(&mut pb), b)
+                r.draw_wireframe(&mut fa, Some(&mut pa), a),
+                r.draw_wireframe(&mut fb, Some(&mut pb), b)
             );
             let _ = (pa, pb);
             assert!(ba == bb, "codes differ: {a:?} / {b:?}");

@@ -12,7 +12,9 @@ use wraster::format::{
 use wraster::packed::{resolve, Input};
 use wraster::recip::{DefaultRecip, PerPixel, PrevPixel, Quake, SpanRecip, WSpan};
 use wraster::scenes::{Scene, HEIGHT, WIDTH};
-use wraster::{Codec, Compare, DepthMode, Error, Packed, Rasterizer, RenderState, Vertex};
+use wraster::{
+    Codec, Compare, DepthBuffer, DepthMode, Error, NoDepth, Rasterizer, RenderState, Vertex,
+};
 
 const W: u16 = 96;
 const H: u16 = 64;
@@ -288,8 +290,8 @@ fn modes_fall_back_and_depth_is_off_without_a_buffer() {
         state.mode = mode;
         let mut r = Rasterizer::<PerPixel<DefaultRecip>>::new(state);
         let mut frame = Frame::new(W as u32, H as u32);
-        let a = r.draw_format::<W16, _>(&mut frame, None, &near).unwrap();
-        let b = r.draw_format::<W16, _>(&mut frame, None, &far).unwrap();
+        let a = r.draw(&mut frame, NoDepth, &near).unwrap();
+        let b = r.draw(&mut frame, NoDepth, &far).unwrap();
         assert_eq!((a.written, b.written), (a.fragments, b.fragments));
         assert!(a.written > 2000);
         assert!(
@@ -300,15 +302,15 @@ fn modes_fall_back_and_depth_is_off_without_a_buffer() {
             continue; // Z with a W16 buffer is refused: below
         }
         // With a buffer and mode Off, the buffer is untouched and everything passes.
-        let mut bytes = vec![0u8; W as usize * H as usize * 2];
-        let mut buf = Packed::<W16>::new(&mut bytes, W, H).unwrap();
-        buf.clear(&state.range);
-        let s = r.draw_format(&mut frame, Some(&mut buf), &near).unwrap();
-        let t = r.draw_format(&mut frame, Some(&mut buf), &far).unwrap();
+        let mut bytes = vec![0u16; W as usize * H as usize];
+        let mut buf = DepthBuffer::<W16>::new_format(&mut bytes, W, H).unwrap();
+        buf.clear_for(&state.range);
+        let s = r.draw(&mut frame, Some(&mut buf), &near).unwrap();
+        let t = r.draw(&mut frame, Some(&mut buf), &far).unwrap();
         if mode == Off {
             assert_eq!((s.written, t.written), (s.fragments, t.fragments));
             assert!(
-                bytes.iter().all(|&b| b == 0xff),
+                bytes.iter().all(|&b| b == 0xffff),
                 "mode Off must not write depth"
             );
         } else if mode == WM {
@@ -320,10 +322,10 @@ fn modes_fall_back_and_depth_is_off_without_a_buffer() {
     state.mode = Z;
     let mut r = Rasterizer::<PerPixel<DefaultRecip>>::new(state);
     let mut frame = Frame::new(W as u32, H as u32);
-    let mut bytes = vec![0u8; W as usize * H as usize * 2];
-    let mut buf = Packed::<W16>::new(&mut bytes, W, H).unwrap();
+    let mut bytes = vec![0u16; W as usize * H as usize];
+    let mut buf = DepthBuffer::<W16>::new_format(&mut bytes, W, H).unwrap();
     assert_eq!(
-        r.draw_format(&mut frame, Some(&mut buf), &near),
+        r.draw(&mut frame, Some(&mut buf), &near),
         Err(Error::ZWithWFormat)
     );
     assert_eq!(frame.writes.iter().sum::<u32>(), 0);
@@ -376,17 +378,17 @@ fn less_keeps_the_nearest_in_every_format() {
 /// A packed buffer of the wrong size is refused; bands of a packed buffer cover exactly their rows.
 #[test]
 fn packed_buffers_check_their_size() {
-    let mut b = vec![0u8; 10];
+    let mut b = vec![[0u8; 3]; 3];
     assert!(matches!(
-        Packed::<Z24>::new(&mut b, 2, 2),
+        DepthBuffer::<Z24>::new_format(&mut b, 2, 2),
         Err(Error::BufferSize {
-            expected: 12,
-            actual: 10
+            expected: 4,
+            actual: 3
         })
     ));
-    let mut b = vec![0u8; 12];
-    let buf = Packed::<Z24>::new(&mut b, 2, 2).unwrap();
-    assert_eq!(buf.get(1, 1), Some(0));
+    let mut b = vec![[0u8; 3]; 4];
+    let buf = DepthBuffer::<Z24>::new_format(&mut b, 2, 2).unwrap();
+    assert_eq!(buf.code(1, 1), Some(0));
     assert_eq!(buf.get(2, 1), None);
 }
 
@@ -420,18 +422,18 @@ fn bias_removes_coplanar_fighting_in_every_16_bit_format_and_reversed_z() {
         let b = tri([(8.0, 7.0), (50.0, 12.0), (12.0, 38.0)], Rgb565::BLUE);
         let base = RenderState::new(1.0, 1000.0).unwrap();
         let mut frame = Frame::new(W as u32, H as u32);
-        let mut bytes = vec![0u8; W as usize * H as usize * F::BYTES];
-        let mut buf = Packed::<F>::new(&mut bytes, W, H).unwrap();
-        buf.clear(&base.range);
+        let mut bytes = vec![<F as DepthFormat>::Word::default(); W as usize * H as usize];
+        let mut buf = DepthBuffer::<F>::new_format(&mut bytes, W, H).unwrap();
+        buf.clear_for(&base.range);
         Rasterizer::<PerPixel<DefaultRecip>>::new(base)
-            .draw_format(&mut frame, Some(&mut buf), &a)
+            .draw(&mut frame, Some(&mut buf), &a)
             .unwrap();
         let state = RenderState {
             depth_bias: bias,
             ..base
         };
         let s = Rasterizer::<PerPixel<DefaultRecip>>::new(state)
-            .draw_format(&mut frame, Some(&mut buf), &b)
+            .draw(&mut frame, Some(&mut buf), &b)
             .unwrap();
         (
             s.fragments as usize,
@@ -500,12 +502,12 @@ fn every_comparison_on_the_packed_path() {
         cmp: Compare,
     ) -> (Vec<Rgb565>, u32) {
         let mut frame = Frame::new(WIDTH as u32, HEIGHT as u32);
-        let mut bytes = vec![0u8; WIDTH as usize * HEIGHT as usize * F::BYTES];
-        let mut buf = Packed::<F>::new(&mut bytes, WIDTH, HEIGHT).unwrap();
-        buf.clear(&state.range);
+        let mut bytes = vec![<F as DepthFormat>::Word::default(); WIDTH as usize * HEIGHT as usize];
+        let mut buf = DepthBuffer::<F>::new_format(&mut bytes, WIDTH, HEIGHT).unwrap();
+        buf.clear_for(&state.range);
         let mut r = Rasterizer::<PerPixel<DefaultRecip>>::new(state);
         for t in tris {
-            r.draw_format(&mut frame, Some(&mut buf), t).unwrap();
+            r.draw(&mut frame, Some(&mut buf), t).unwrap();
         }
         r.state.compare = cmp;
         let mut second = 0;
@@ -514,10 +516,7 @@ fn every_comparison_on_the_packed_path() {
                 color: Rgb565::MAGENTA,
                 ..v
             });
-            second += r
-                .draw_format(&mut frame, Some(&mut buf), &c)
-                .unwrap()
-                .written;
+            second += r.draw(&mut frame, Some(&mut buf), &c).unwrap().written;
         }
         (frame.px, second)
     }
@@ -539,4 +538,68 @@ fn every_comparison_on_the_packed_path() {
             assert!(sw > 1000, "{cmp:?}: the second pass draws");
         }
     }
+}
+
+/// One draw method for every depth argument: a buffer given as `&mut`, as `Some` or (for the depth-off draw) as
+/// `NoDepth` draws the same frame, codes and stats as the span loop generic over the format given the same argument
+/// (`draw_generic`): on W16 with the fast tier (whose own loops `draw` takes, the same codes as the generic loop's
+/// W16 instance), on W16 with `Quake` (which `draw` gives to the generic loop) and on Z24; with `NoDepth` every
+/// fragment in the depth range is written.
+#[test]
+fn one_draw_method_for_every_depth_argument() {
+    use wraster::format::Storage;
+    use wraster::recip::Fast;
+    use wraster::{DepthBuffer, NoDepth};
+    let scene = Scene::Overdraw;
+    let (n, f) = scene.depth_range();
+    let tris: Vec<_> = scene.tris().collect();
+    let state = RenderState::new(n, f).unwrap();
+    fn run<F: Codec, R: WSpan>(
+        tris: &[[Vertex<Rgb565>; 3]],
+        state: RenderState,
+        how: u8,
+    ) -> (Frame, Vec<u32>, wraster::Stats) {
+        let mut frame = Frame::new(WIDTH as u32, HEIGHT as u32);
+        let mut words = vec![F::Word::default(); WIDTH as usize * HEIGHT as usize];
+        let mut buf = DepthBuffer::<F>::new_format(&mut words, WIDTH, HEIGHT).unwrap();
+        buf.clear_for(&state.range);
+        let mut r = Rasterizer::<R>::new(state);
+        let mut stats = wraster::Stats::default();
+        for t in tris {
+            stats += match how {
+                0 => r.draw(&mut frame, &mut buf, t),
+                1 => r.draw(&mut frame, Some(&mut buf), t),
+                2 => r.draw_generic(&mut frame, &mut buf, t),
+                3 => r.draw(&mut frame, NoDepth, t),
+                _ => r.draw_generic(&mut frame, NoDepth, t),
+            }
+            .unwrap();
+        }
+        (frame, words.iter().map(|w| w.code()).collect(), stats)
+    }
+    fn check<F: Codec, R: WSpan>(tris: &[[Vertex<Rgb565>; 3]], state: RenderState) {
+        let a = run::<F, R>(tris, state, 0);
+        for how in [1, 2] {
+            let b = run::<F, R>(tris, state, how);
+            assert!(a.0 == b.0 && a.1 == b.1, "{} {} {how}", F::NAME, R::NAME);
+            assert_eq!(a.2, b.2, "{} {} {how}", F::NAME, R::NAME);
+        }
+        assert!(
+            a.2.written < a.2.fragments,
+            "{}: the depth test hides some",
+            F::NAME
+        );
+    }
+    check::<W16, Fast>(&tris, state);
+    check::<W16, Quake<8>>(&tris, state);
+    check::<Z24, Fast>(&tris, state);
+    let (off, gen) = (
+        run::<W16, Fast>(&tris, state, 3),
+        run::<W16, Fast>(&tris, state, 4),
+    );
+    assert!(off.0 == gen.0 && off.2 == gen.2);
+    assert_eq!(
+        off.2.written, off.2.fragments,
+        "depth off writes every fragment"
+    );
 }

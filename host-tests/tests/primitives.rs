@@ -5,7 +5,7 @@ use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
 use host_tests::{snap, Frame, Rng};
 use wraster::format::{DepthFormat, W16, Z24};
 use wraster::recip::{DefaultRecip, PerPixel};
-use wraster::{Codec, Compare, Cull, Packed, Rasterizer, RenderState, Vertex};
+use wraster::{Codec, Compare, Cull, DepthBuffer, Rasterizer, RenderState, Vertex};
 
 const W: u16 = 96;
 const H: u16 = 64;
@@ -13,10 +13,10 @@ const FAR: f32 = 1000.0;
 
 type R = Rasterizer<PerPixel<DefaultRecip>>;
 
-fn buffer<'a, F: Codec>(bytes: &'a mut Vec<u8>, state: &RenderState) -> Packed<'a, F> {
-    *bytes = vec![0; W as usize * H as usize * F::BYTES];
-    let mut b = Packed::<F>::new(bytes, W, H).unwrap();
-    b.clear(&state.range);
+fn buffer<'a, F: Codec>(bytes: &'a mut Vec<F::Word>, state: &RenderState) -> DepthBuffer<'a, F> {
+    *bytes = vec![F::Word::default(); W as usize * H as usize];
+    let mut b = DepthBuffer::<F>::new_format(bytes, W, H).unwrap();
+    b.clear_for(&state.range);
     b
 }
 
@@ -81,9 +81,7 @@ fn lines_follow_the_rule_and_carry_exact_depth() {
         let mut frame = Frame::new(W as u32, H as u32);
         let mut bytes = Vec::new();
         let mut buf = buffer::<W16>(&mut bytes, &state);
-        let stats = r
-            .draw_line_format(&mut frame, Some(&mut buf), &line)
-            .unwrap();
+        let stats = r.draw_line(&mut frame, Some(&mut buf), &line).unwrap();
         let want: Vec<_> = reference_line(&line[0], &line[1])
             .into_iter()
             .filter(|&(x, y, _)| x >= 0 && x < W as i32 && y >= 0 && y < H as i32)
@@ -134,7 +132,7 @@ fn connected_lines_share_no_pixel() {
     for s in pts.windows(2) {
         let v = |(x, y): (f32, f32)| Vertex::new(x, y, 50.0, Rgb565::GREEN);
         total += r
-            .draw_line_format(&mut frame, Some(&mut buf), &[v(s[0]), v(s[1])])
+            .draw_line(&mut frame, Some(&mut buf), &[v(s[0]), v(s[1])])
             .unwrap()
             .written;
     }
@@ -153,27 +151,27 @@ fn points_cover_their_pixel_at_their_depth() {
     let mut bytes = Vec::new();
     let mut buf = buffer::<W16>(&mut bytes, &state);
     let p = Vertex::new(10.99, 20.01, 250.0, Rgb565::RED);
-    let s = r.draw_point_format(&mut frame, Some(&mut buf), &p).unwrap();
+    let s = r.draw_point(&mut frame, Some(&mut buf), &p).unwrap();
     assert_eq!((s.fragments, s.written), (1, 1));
     assert_eq!(frame.writes[(20 * W as usize) + 10], 1);
-    assert_eq!(buf.get(10, 20), Some(W16::encode(250.0, 1.0, FAR as f64)));
+    assert_eq!(buf.code(10, 20), Some(W16::encode(250.0, 1.0, FAR as f64)));
     // a nearer triangle hides a farther point drawn after it
     let tri = [
         Vertex::new(30.0, 30.0, 100.0, Rgb565::BLUE),
         Vertex::new(60.0, 30.0, 100.0, Rgb565::BLUE),
         Vertex::new(30.0, 60.0, 100.0, Rgb565::BLUE),
     ];
-    r.draw_format(&mut frame, Some(&mut buf), &tri).unwrap();
+    r.draw(&mut frame, Some(&mut buf), &tri).unwrap();
     let behind = Vertex::new(35.5, 35.5, 200.0, Rgb565::RED);
     assert_eq!(
-        r.draw_point_format(&mut frame, Some(&mut buf), &behind)
+        r.draw_point(&mut frame, Some(&mut buf), &behind)
             .unwrap()
             .written,
         0
     );
     let before = Vertex::new(36.5, 35.5, 50.0, Rgb565::RED);
     assert_eq!(
-        r.draw_point_format(&mut frame, Some(&mut buf), &before)
+        r.draw_point(&mut frame, Some(&mut buf), &before)
             .unwrap()
             .written,
         1
@@ -185,7 +183,7 @@ fn points_cover_their_pixel_at_their_depth() {
         Vertex::new(5.0, 5.0, 2000.0, Rgb565::RED),
     ] {
         assert_eq!(
-            r.draw_point_format(&mut frame, Some(&mut buf), &q)
+            r.draw_point(&mut frame, Some(&mut buf), &q)
                 .unwrap()
                 .written,
             0,
@@ -202,12 +200,10 @@ fn points_cover_their_pixel_at_their_depth() {
         },
     ];
     for q in bad {
-        assert!(r.draw_point_format(&mut frame, Some(&mut buf), &q).is_err());
+        assert!(r.draw_point(&mut frame, Some(&mut buf), &q).is_err());
+        assert!(r.draw_line(&mut frame, Some(&mut buf), &[p, q]).is_err());
         assert!(r
-            .draw_line_format(&mut frame, Some(&mut buf), &[p, q])
-            .is_err());
-        assert!(r
-            .draw_wireframe_format(&mut frame, Some(&mut buf), &[p, q, p])
+            .draw_wireframe(&mut frame, Some(&mut buf), &[p, q, p])
             .is_err());
     }
     assert_eq!(
@@ -216,7 +212,7 @@ fn points_cover_their_pixel_at_their_depth() {
         "an error wrote something"
     );
     assert_eq!(
-        r.draw_line_format(&mut frame, Some(&mut buf), &[p, p])
+        r.draw_line(&mut frame, Some(&mut buf), &[p, p])
             .unwrap()
             .culled,
         1
@@ -242,9 +238,7 @@ fn bias_lifts_wireframe_but_not_lines() {
         let mut frame = Frame::new(W as u32, H as u32);
         let mut bytes = Vec::new();
         let mut buf = buffer::<W16>(&mut bytes, &base);
-        R::new(base)
-            .draw_format(&mut frame, Some(&mut buf), &tri)
-            .unwrap();
+        R::new(base).draw(&mut frame, Some(&mut buf), &tri).unwrap();
         let solid = frame.writes.clone();
         let state = RenderState {
             depth_bias: if bias { -4.0 } else { 0.0 },
@@ -264,17 +258,16 @@ fn bias_lifts_wireframe_but_not_lines() {
             ..base
         });
         if wire {
-            r.draw_wireframe_format(&mut frame, Some(&mut buf), &red)
-                .unwrap();
+            r.draw_wireframe(&mut frame, Some(&mut buf), &red).unwrap();
             always
-                .draw_wireframe_format(&mut drawn, Some(&mut any), &red)
+                .draw_wireframe(&mut drawn, Some(&mut any), &red)
                 .unwrap();
         } else {
             for (a, b) in [(0, 1), (1, 2), (2, 0)] {
-                r.draw_line_format(&mut frame, Some(&mut buf), &[red[a], red[b]])
+                r.draw_line(&mut frame, Some(&mut buf), &[red[a], red[b]])
                     .unwrap();
                 always
-                    .draw_line_format(&mut drawn, Some(&mut any), &[red[a], red[b]])
+                    .draw_line(&mut drawn, Some(&mut any), &[red[a], red[b]])
                     .unwrap();
             }
         }
@@ -316,25 +309,25 @@ fn wireframe_culls_like_solid() {
     let mut buf = buffer::<W16>(&mut bytes, &state);
     assert_eq!(
         R::new(state)
-            .draw_wireframe_format(&mut frame, Some(&mut buf), &flat)
+            .draw_wireframe(&mut frame, Some(&mut buf), &flat)
             .unwrap()
             .culled,
         1
     );
     state.cull = Cull::Cw;
     let solid = R::new(state)
-        .draw_format(&mut frame, Some(&mut buf), &cw)
+        .draw(&mut frame, Some(&mut buf), &cw)
         .unwrap()
         .culled;
     let wire = R::new(state)
-        .draw_wireframe_format(&mut frame, Some(&mut buf), &cw)
+        .draw_wireframe(&mut frame, Some(&mut buf), &cw)
         .unwrap()
         .culled;
     assert_eq!((solid, wire), (1, 1));
     state.cull = Cull::Ccw;
     assert!(
         R::new(state)
-            .draw_wireframe_format(&mut frame, Some(&mut buf), &cw)
+            .draw_wireframe(&mut frame, Some(&mut buf), &cw)
             .unwrap()
             .written
             > 100

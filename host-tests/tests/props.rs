@@ -99,16 +99,16 @@ proptest! {
         fn one<F: wraster::Codec, R: wraster::recip::WSpan>(t: &[Vertex<Rgb565>; 3], state: RenderState, kind: u8) -> Result<(), TestCaseError> {
             let mut r = wraster::Rasterizer::<R>::new(state);
             let mut frame = Frame::new(W as u32, H as u32);
-            let mut bytes = vec![0u8; W as usize * H as usize * F::BYTES];
-            let mut buf = wraster::Packed::<F>::new(&mut bytes, W, H).unwrap();
-            buf.clear(&state.range);
+            let mut bytes = vec![<F as wraster::format::DepthFormat>::Word::default(); W as usize * H as usize];
+            let mut buf = wraster::DepthBuffer::<F>::new_format(&mut bytes, W, H).unwrap();
+            buf.clear_for(&state.range);
             let cleared = bytes.clone();
-            let mut buf = wraster::Packed::<F>::new(&mut bytes, W, H).unwrap();
+            let mut buf = wraster::DepthBuffer::<F>::new_format(&mut bytes, W, H).unwrap();
             let out = match kind {
-                0 => r.draw_format(&mut frame, Some(&mut buf), t),
-                1 => r.draw_line_format(&mut frame, Some(&mut buf), &[t[0], t[1]]),
-                2 => r.draw_point_format(&mut frame, Some(&mut buf), &t[2]),
-                _ => r.draw_wireframe_format(&mut frame, Some(&mut buf), t),
+                0 => r.draw(&mut frame, Some(&mut buf), t),
+                1 => r.draw_line(&mut frame, Some(&mut buf), &[t[0], t[1]]),
+                2 => r.draw_point(&mut frame, Some(&mut buf), &t[2]),
+                _ => r.draw_wireframe(&mut frame, Some(&mut buf), t),
             };
             match out {
                 Ok(stats) => {

@@ -12,11 +12,11 @@ use core::fmt::Write;
 use embedded_graphics_core::pixelcolor::raw::RawU16;
 use embedded_graphics_core::pixelcolor::Rgb565;
 use wraster::clip::Viewport;
-use wraster::format::W16;
+
 use wraster::mesh::{Colors, Mesh, MeshFrame, Projected};
 use wraster::recip::SpanRecip;
 use wraster::{
-    Codec, ColorBand, DepthBuffer, Error, Packed, Rasterizer, RenderState, Stats, Vertex,
+    Codec, ColorBand, DepthBuffer, Error, NoDepth, Rasterizer, RenderState, Stats, Vertex,
 };
 
 /// A baked triangle: `(x, y, rhw)` bit patterns per vertex, the RGB565 colour, the rows it can cover.
@@ -212,6 +212,11 @@ pub struct Run {
     pub bound: bool,
 }
 
+/// `v` as twice as many `u16`s (the plans' depth storage: `u32`s, so that a 4-byte format's words are aligned).
+pub fn u16_words(v: &mut [u32]) -> &mut [u16] {
+    bytemuck::cast_slice_mut(v)
+}
+
 /// Renders `scene` band by band with the given buffers (`color.len() == depth.len() == WIDTH * band rows`).
 /// Each band clears its buffers, then draws only the triangles whose row range meets it (binning).
 /// `R` is the reciprocal strategy (`wraster::recip`).
@@ -333,7 +338,7 @@ type ForEachTri<'a> = dyn FnMut(
 /// lean W16 path. Hash and counts as [`run_scene`]: each row's colours, then its stored depth bytes (none without
 /// a buffer).
 #[allow(clippy::too_many_arguments)]
-fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
+fn run_planned_tris<F: Codec<Word: bytemuck::Pod>, R: SpanRecip, C: Counter, const KIND: u8>(
     tris: &mut ForEachTri<'_>,
     plan: &PlanData,
     state: RenderState,
@@ -362,7 +367,7 @@ fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
         if KIND == NO_DEPTH {
             counter.start();
             let res = tris((b0, b1), &mut |v| {
-                *stats += r.draw_format::<W16, _>(&mut band, None, v)?;
+                *stats += r.draw(&mut band, NoDepth, v)?;
                 Ok(())
             });
             instructions += counter.stop();
@@ -387,13 +392,19 @@ fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
                 hash.words(&buf.data()[row * w..(row + 1) * w]);
             }
         } else {
+            // The format's words in the plan's storage (`u32`-aligned: [`u16_words`]); a 4-byte format's buffer
+            // starts on a 4-byte boundary.
             let bytes: &mut [u8] = bytemuck::cast_slice_mut(depth);
-            let bytes = &mut bytes[..n * F::BYTES];
-            let mut buf = Packed::<F>::band(bytes, WIDTH, y0 as i32, h)?;
-            buf.clear(&state.range);
+            let words: &mut [F::Word] = bytemuck::try_cast_slice_mut(&mut bytes[..n * F::BYTES])
+                .map_err(|_| Error::BufferSize {
+                    expected: n * F::BYTES,
+                    actual: 0,
+                })?;
+            let mut buf = DepthBuffer::<F>::band_format(words, WIDTH, y0 as i32, h)?;
+            buf.clear_for(&state.range);
             counter.start();
             let res = tris((b0, b1), &mut |v| {
-                *stats += r.draw_format(&mut band, Some(&mut buf), v)?;
+                *stats += r.draw(&mut band, &mut buf, v)?;
                 Ok(())
             });
             instructions += counter.stop();
@@ -415,7 +426,13 @@ fn run_planned_tris<F: Codec, R: SpanRecip, C: Counter, const KIND: u8>(
 /// torus is transformed by the mesh path each frame and its triangles drawn from the transformed vertices (the
 /// mesh path's own draw takes a W16 buffer only). `depth` must hold the plan's bands (`PlanData::depth_ram` bytes)
 /// and `color` at least one colour band.
-pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE: usize>(
+pub fn run_plan<
+    F: Codec<Word: bytemuck::Pod>,
+    R: SpanRecip,
+    C: Counter,
+    const KIND: u8,
+    const SCENE: usize,
+>(
     plan: &PlanData,
     color: &mut [u16],
     depth: &mut [u16],
@@ -553,7 +570,13 @@ pub fn run_plan<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE:
 /// [`run_plan`] and its `bench` line, with `format=` the plan's and the added keys `plan=1 depth_ram=..
 /// visibility_errors=..` (and `frames=8 instr_per_frame=` for the torus), or an `error` line; `false` on an error.
 #[allow(clippy::too_many_arguments)]
-pub fn run_plan_line<F: Codec, R: SpanRecip, C: Counter, const KIND: u8, const SCENE: usize>(
+pub fn run_plan_line<
+    F: Codec<Word: bytemuck::Pod>,
+    R: SpanRecip,
+    C: Counter,
+    const KIND: u8,
+    const SCENE: usize,
+>(
     board: &str,
     core: &str,
     plan: &PlanData,

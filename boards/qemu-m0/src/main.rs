@@ -226,7 +226,7 @@ use {
 #[entry]
 fn main() -> ! {
     static mut COLOR: [u16; COLOR_LEN] = [0; COLOR_LEN];
-    static mut DEPTH: [u16; DEPTH_LEN] = [0; DEPTH_LEN];
+    static mut DEPTH: [u32; DEPTH_LEN] = [0; DEPTH_LEN];
     static mut VERTS: [Projected; VERTS_LEN] = [Projected {
         x: 0.0,
         y: 0.0,
@@ -239,7 +239,7 @@ fn main() -> ! {
         "qemu-m0",
         "m0",
         COLOR,
-        DEPTH,
+        wraster_board::u16_words(DEPTH),
         VERTS,
         BINS,
         &mut counter,

@@ -152,7 +152,7 @@ const _: () = assert!(
 #[entry]
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];
-    static mut DEPTH: [u16; DEPTH_LEN] = [0; DEPTH_LEN];
+    static mut DEPTH: [u32; DEPTH_LEN] = [0; DEPTH_LEN];
     static mut VERTS: [Projected; VERTS_LEN] = [Projected {
         x: 0.0,
         y: 0.0,
@@ -165,7 +165,7 @@ fn main() -> ! {
         "qemu-m4",
         "m4",
         COLOR,
-        DEPTH,
+        wraster_board::u16_words(DEPTH),
         VERTS,
         BINS,
         &mut counter,

@@ -15,13 +15,13 @@ use embedded_graphics::prelude::RgbColor;
 use host_tests::plot::{heat_map, pareto_plot, rows, step_plot, Point2};
 use host_tests::{field, have, random_tri, reference_frame, run_board, Frame, RefFrame, Rng};
 use wraster::format::{
-    DepthFormat, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F,
+    DepthFormat, Storage, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F,
 };
 use wraster::recip::{
     DefaultRecip, F32Div, Newton, PerPixel, PrevPixel, Quake, SpanRecip, Table64, WSpan,
 };
 use wraster::scenes::{Scene, HEIGHT, WIDTH};
-use wraster::{Codec, Compare, DepthBuffer, Packed, Rasterizer, RenderState, Vertex};
+use wraster::{Codec, Compare, DepthBuffer, Rasterizer, RenderState, Vertex};
 
 type Tri = [Vertex<Rgb565>; 3];
 
@@ -139,7 +139,8 @@ fn render_lean<R: SpanRecip>(
     )
 }
 
-/// The packed path of any format (`Rasterizer::draw_format`).
+/// Any format through `Rasterizer::draw` (W16 with a per-pixel reciprocal takes the tiers' own W16 loops, as a
+/// firmware's draw does; the other formats and `Quake` the generic span loop).
 fn render_case<F: Codec, R: WSpan>(
     case: &Case,
     tris: &[Tri],
@@ -148,25 +149,17 @@ fn render_case<F: Codec, R: WSpan>(
     let mut state = RenderState::new(case.near, case.far).unwrap();
     state.compare = compare;
     let mut frame = touched_frame(case);
-    let mut bytes = vec![0u8; case.w as usize * case.h as usize * F::BYTES];
-    let mut buf = Packed::<F>::new(&mut bytes, case.w, case.h).unwrap();
-    buf.clear(&state.range);
+    let mut bytes = vec![<F as DepthFormat>::Word::default(); case.w as usize * case.h as usize];
+    let mut buf = DepthBuffer::<F>::new_format(&mut bytes, case.w, case.h).unwrap();
+    buf.clear_for(&state.range);
     let mut r = Rasterizer::<R>::new(state);
     let t0 = Instant::now();
     let mut written = 0;
     for t in tris {
-        written += r
-            .draw_format(&mut frame, Some(&mut buf), t)
-            .unwrap()
-            .written;
+        written += r.draw(&mut frame, Some(&mut buf), t).unwrap().written;
     }
     let ns = t0.elapsed().as_nanos() as f64;
-    (
-        frame,
-        bytes.chunks_exact(F::BYTES).map(F::unpack).collect(),
-        written,
-        ns,
-    )
+    (frame, bytes.iter().map(|w| w.code()).collect(), written, ns)
 }
 
 /// Compares a rendered frame with the reference's.
