@@ -2,11 +2,7 @@
 //! Rogers, "W-Buffering in Direct3D" (NVIDIA) (`W_scaled = W / W_far * scale_factor`).
 
 use crate::format::{DepthFormat, Storage, W16};
-use crate::input::VertexInput;
-use crate::recip::WSpan;
-use crate::{Codec, DepthRange, Error, Rasterizer, Stats};
-use embedded_graphics_core::draw_target::DrawTarget;
-use embedded_graphics_core::pixelcolor::PixelColor;
+use crate::{Codec, DepthRange, Error};
 
 /// The code of the far plane, and of a cleared buffer.
 pub const W16_FAR: u16 = u16::MAX;
@@ -244,104 +240,6 @@ impl<'a> DepthBuffer<'a, W16> {
             &mut []
         };
         (row, seg)
-    }
-}
-
-/// What a draw method takes for depth: a buffer of any format (`&mut DepthBuffer<F>`), an `Option` of one, or
-/// [`NoDepth`] (depth off: the rows and columns drawn are then the colour target's). One draw method per primitive
-/// takes any of them; the format decides the loop (a W16 buffer with a per-pixel reciprocal: the fast tier's).
-pub trait IntoDepth<'b, 'a: 'b> {
-    /// The buffer's format ([`W16`] for [`NoDepth`], which stores nothing).
-    type Format: Codec;
-    /// The buffer, if any.
-    fn into_depth(self) -> Option<&'b mut DepthBuffer<'a, Self::Format>>;
-    /// [`crate::Rasterizer::draw`] of one triangle into it (the format's loops: [`Codec::draw_into`]), or with depth
-    /// off. A method of this trait, so that a draw into a buffer instantiates no depth-off path, and one with depth
-    /// off no format's.
-    #[doc(hidden)]
-    fn draw_triangle<R: WSpan, D, V>(
-        &mut self,
-        r: &mut Rasterizer<R>,
-        target: &mut D,
-        v: &[V; 3],
-    ) -> Result<Stats, Error>
-    where
-        D: DrawTarget,
-        D::Color: PixelColor,
-        V: VertexInput<Color = D::Color>;
-}
-
-impl<'b, 'a: 'b, F: Codec> IntoDepth<'b, 'a> for &'b mut DepthBuffer<'a, F> {
-    type Format = F;
-    #[inline(always)]
-    fn into_depth(self) -> Option<&'b mut DepthBuffer<'a, F>> {
-        Some(self)
-    }
-    #[inline(always)]
-    fn draw_triangle<R: WSpan, D, V>(
-        &mut self,
-        r: &mut Rasterizer<R>,
-        target: &mut D,
-        v: &[V; 3],
-    ) -> Result<Stats, Error>
-    where
-        D: DrawTarget,
-        D::Color: PixelColor,
-        V: VertexInput<Color = D::Color>,
-    {
-        F::draw_into(r, target, self, v)
-    }
-}
-
-impl<'b, 'a: 'b, F: Codec> IntoDepth<'b, 'a> for Option<&'b mut DepthBuffer<'a, F>> {
-    type Format = F;
-    #[inline(always)]
-    fn into_depth(self) -> Option<&'b mut DepthBuffer<'a, F>> {
-        self
-    }
-    #[inline(always)]
-    fn draw_triangle<R: WSpan, D, V>(
-        &mut self,
-        r: &mut Rasterizer<R>,
-        target: &mut D,
-        v: &[V; 3],
-    ) -> Result<Stats, Error>
-    where
-        D: DrawTarget,
-        D::Color: PixelColor,
-        V: VertexInput<Color = D::Color>,
-    {
-        match self {
-            Some(d) => F::draw_into(r, target, d, v),
-            None => r.draw_packed::<F, D>(target, None, v),
-        }
-    }
-}
-
-/// No depth buffer: depth off, every covered pixel in the depth range drawn, in the colour target's rows and
-/// columns.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct NoDepth;
-
-impl IntoDepth<'static, 'static> for NoDepth {
-    type Format = W16;
-    #[inline(always)]
-    fn into_depth(self) -> Option<&'static mut DepthBuffer<'static, W16>> {
-        None
-    }
-    #[inline(always)]
-    fn draw_triangle<R: WSpan, D, V>(
-        &mut self,
-        r: &mut Rasterizer<R>,
-        target: &mut D,
-        v: &[V; 3],
-    ) -> Result<Stats, Error>
-    where
-        D: DrawTarget,
-        D::Color: PixelColor,
-        V: VertexInput<Color = D::Color>,
-    {
-        r.draw_packed::<W16, D>(target, None, v)
     }
 }
 

@@ -107,6 +107,7 @@ extern crate std;
 
 pub mod clip;
 mod depth;
+mod draw;
 mod edge;
 mod error;
 mod fast;
@@ -141,7 +142,8 @@ pub(crate) fn xorshift(mut s: u64) -> impl FnMut() -> u64 + Copy {
 
 #[cfg(feature = "coarse")]
 pub use depth::bound_len;
-pub use depth::{DepthBuffer, DepthStore, IntoDepth, NoDepth, W16_FAR};
+pub use depth::{DepthBuffer, DepthStore, W16_FAR};
+pub use draw::{IntoDepth, NoDepth};
 pub use error::Error;
 pub use input::{FixedVertex, VertexInput};
 pub use packed::{Codec, Resolved};

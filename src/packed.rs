@@ -19,7 +19,6 @@ use embedded_graphics_core::pixelcolor::PixelColor;
 use embedded_graphics_core::prelude::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 
-use crate::depth::IntoDepth;
 use crate::edge::Sub;
 use crate::fixed::{div_u128, split};
 use crate::format::{DepthFormat, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
@@ -417,30 +416,19 @@ impl<R: WSpan> Rasterizer<R> {
     }
 }
 
-/// Points, lines and wireframe triangles (the Windows CE "Depth Buffering" docs' primitives), through the same `T` (RHW) path, the same
-/// W strategy and the same depth test as solid triangles. Depth bias applies to wireframe triangles, never to points
-/// or lines (the Windows CE "Depth Buffering" docs).
-///
-/// Rules. A point covers the pixel that contains it, `(floor x, floor y)`, at its own depth. A line covers, for each
-/// column (x-major, `|dx| >= |dy|`) or row (y-major) whose pixel centre lies in `[start, end)` of the snapped
-/// endpoints' major coordinate (ordered increasing), the pixel containing the line's point at that centre: one pixel
-/// per major step, the upper endpoint excluded, so connected lines share no pixel. `T` along it is the line's exact
-/// interpolation at the pixel centre, its step rounded once (as for triangles: at `k` steps it errs by at most
-/// `(1 + k) / 2` units of `2^-F`). A wireframe triangle is culled like a solid one and draws its three edges with the
-/// triangle's depth bias, in its first vertex's colour.
+/// Points, lines and wireframe triangles into any format (the rules: [`Rasterizer::draw_line`]).
 impl<R: WSpan> Rasterizer<R> {
-    /// Draws one point. On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_point<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
+    /// [`Rasterizer::draw_point`] into a buffer of format `F` or none.
+    pub(crate) fn point_any<F: Codec, D>(
         &mut self,
         target: &mut D,
-        depth: B,
+        depth: Option<&mut DepthBuffer<'_, F>>,
         v: &impl VertexInput<Color = D::Color>,
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
         D::Color: PixelColor,
     {
-        let depth = depth.into_depth();
         let s = self.setup(core::array::from_ref(v))?;
         let z = linear_z60(&self.zconst(), s.t[0], s.frac);
         let line = Line1 {
@@ -450,23 +438,22 @@ impl<R: WSpan> Rasterizer<R> {
             dz: 0,
         };
         let at = |_k: usize| (s.p[0].x >> 8, s.p[0].y >> 8);
-        self.pixels::<B::Format, D>(target, depth, &line, 1, at, 0, s.frac, v.color())
+        self.pixels::<F, D>(target, depth, &line, 1, at, 0, s.frac, v.color())
     }
 
-    /// Draws one line from `v[0]` to `v[1]` (flat, `v[0]`'s colour). On an error nothing is written, except for a failing `target` ([`Error::Target`]).
-    pub fn draw_line<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
+    /// [`Rasterizer::draw_line`] into a buffer of format `F` or none.
+    pub(crate) fn line_any<F: Codec, D>(
         &mut self,
         target: &mut D,
-        depth: B,
+        depth: Option<&mut DepthBuffer<'_, F>>,
         v: &[impl VertexInput<Color = D::Color>; 2],
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
         D::Color: PixelColor,
     {
-        let depth = depth.into_depth();
         let s = self.setup(v)?;
-        self.line_inner::<B::Format, D>(
+        self.line_inner::<F, D>(
             target,
             depth,
             (s.p[0], s.p[1]),
@@ -477,19 +464,17 @@ impl<R: WSpan> Rasterizer<R> {
         )
     }
 
-    /// Draws the three edges of a triangle, culled like a solid one, with its depth bias. On an error nothing is
-    /// written.
-    pub fn draw_wireframe<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
+    /// [`Rasterizer::draw_wireframe`] into a buffer of format `F` or none.
+    pub(crate) fn wireframe_any<F: Codec, D>(
         &mut self,
         target: &mut D,
-        depth: B,
+        mut depth: Option<&mut DepthBuffer<'_, F>>,
         v: &[impl VertexInput<Color = D::Color>; 3],
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
         D::Color: PixelColor,
     {
-        let mut depth = depth.into_depth();
         let s = self.setup(v)?;
         let [p0, p1, p2] = s.p;
         let area = (p1.x - p0.x) as i64 * (p2.y - p0.y) as i64
@@ -508,10 +493,10 @@ impl<R: WSpan> Rasterizer<R> {
         }
         let range = (1u64 << s.frac, self.state.range.t_max(s.frac));
         let zc = self.zconst();
-        let bias = self.format_bias::<B::Format>(&zc, &s.p, &s.t, s.frac, range);
+        let bias = self.format_bias::<F>(&zc, &s.p, &s.t, s.frac, range);
         let mut stats = Stats::default();
         for (a, b) in [(0, 1), (1, 2), (2, 0)] {
-            stats += self.line_inner::<B::Format, D>(
+            stats += self.line_inner::<F, D>(
                 target,
                 depth.as_deref_mut(),
                 (s.p[a], s.p[b]),

@@ -27,7 +27,7 @@ use embedded_graphics_core::pixelcolor::PixelColor;
 use embedded_graphics_core::prelude::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 
-use crate::depth::{encode_w16, DepthBuffer, IntoDepth, W16_FAR};
+use crate::depth::{encode_w16, DepthBuffer, W16_FAR};
 use crate::edge::{Edge, Sub};
 use crate::fast::{Chord, Divide};
 use crate::fixed::{div_u128, round_shift, split, Divisor};
@@ -214,45 +214,6 @@ impl<R: WSpan> Rasterizer<R> {
             recip: R::default(),
             zc: None,
         }
-    }
-
-    /// Draws one flat-coloured triangle (the colour of its first vertex) into `target` and `depth`: a depth buffer
-    /// of any format (`&mut DepthBuffer<F>`), an `Option` of one, or [`NoDepth`](crate::NoDepth) (depth off; the
-    /// rows and columns are then the target's). A W16 buffer with a per-pixel reciprocal ([`SpanRecip`]) takes the
-    /// fast tier's loops (or the exact tier's, with [`crate::recip::Exact`]); any other format or strategy the span
-    /// loop generic over both (`crate::packed`). The choice is the types', made at compile time: a firmware links
-    /// only the loops of the format and strategy it names. The depth test runs before any colour work for the pixel
-    /// (the Windows CE "Depth Buffering" docs): a passing pixel's colour is sent with its run. On an error nothing is
-    /// written, except for a failing `target` ([`Error::Target`] says what is left).
-    pub fn draw<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
-        &mut self,
-        target: &mut D,
-        depth: B,
-        v: &[impl VertexInput<Color = D::Color>; 3],
-    ) -> Result<Stats, Error>
-    where
-        D: DrawTarget,
-        D::Color: PixelColor,
-    {
-        let mut depth = depth;
-        depth.draw_triangle(self, target, v)
-    }
-
-    /// [`Rasterizer::draw`] through the span loop generic over the format and the strategy whatever the format,
-    /// W16 included (which `draw` gives to its own loops where the strategy is a per-pixel reciprocal): the tests
-    /// compare the two on W16. Not for firmware.
-    #[doc(hidden)]
-    pub fn draw_generic<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
-        &mut self,
-        target: &mut D,
-        depth: B,
-        v: &[impl VertexInput<Color = D::Color>; 3],
-    ) -> Result<Stats, Error>
-    where
-        D: DrawTarget,
-        D::Color: PixelColor,
-    {
-        self.draw_packed(target, depth.into_depth(), v)
     }
 
     /// Snaps and checks `N` vertices and gives their `T` with a common fraction count.

@@ -1,0 +1,210 @@
+//! The draw methods' entry: which loop a primitive takes, chosen by the types of its depth argument (a buffer of any
+//! format, an `Option` of one, or [`NoDepth`]) and of the rasterizer's strategy, at compile time. Above the stages
+//! (`crate::raster`'s set-up and W16 loops, `crate::packed`'s loop generic over the format): they do not import it.
+
+use embedded_graphics_core::draw_target::DrawTarget;
+use embedded_graphics_core::pixelcolor::PixelColor;
+
+use crate::format::W16;
+use crate::input::VertexInput;
+use crate::recip::WSpan;
+use crate::{Codec, DepthBuffer, Error, Rasterizer, Stats};
+
+/// What a draw method takes for depth: a buffer of any format (`&mut DepthBuffer<F>`), an `Option` of one, or
+/// [`NoDepth`] (depth off: the rows and columns drawn are then the colour target's). One draw method per primitive
+/// takes any of them; the format decides the loop (a W16 buffer with a per-pixel reciprocal: the fast tier's).
+pub trait IntoDepth<'b, 'a: 'b> {
+    /// The buffer's format ([`W16`] for [`NoDepth`], which stores nothing).
+    type Format: Codec;
+    /// The buffer, if any.
+    fn into_depth(self) -> Option<&'b mut DepthBuffer<'a, Self::Format>>;
+    /// [`crate::Rasterizer::draw`] of one triangle into it (the format's loops: [`Codec::draw_into`]), or with depth
+    /// off. A method of this trait, so that a draw into a buffer instantiates no depth-off path, and one with depth
+    /// off no format's.
+    #[doc(hidden)]
+    fn draw_triangle<R: WSpan, D, V>(
+        &mut self,
+        r: &mut Rasterizer<R>,
+        target: &mut D,
+        v: &[V; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+        V: VertexInput<Color = D::Color>;
+}
+
+impl<'b, 'a: 'b, F: Codec> IntoDepth<'b, 'a> for &'b mut DepthBuffer<'a, F> {
+    type Format = F;
+    #[inline(always)]
+    fn into_depth(self) -> Option<&'b mut DepthBuffer<'a, F>> {
+        Some(self)
+    }
+    #[inline(always)]
+    fn draw_triangle<R: WSpan, D, V>(
+        &mut self,
+        r: &mut Rasterizer<R>,
+        target: &mut D,
+        v: &[V; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+        V: VertexInput<Color = D::Color>,
+    {
+        F::draw_into(r, target, self, v)
+    }
+}
+
+impl<'b, 'a: 'b, F: Codec> IntoDepth<'b, 'a> for Option<&'b mut DepthBuffer<'a, F>> {
+    type Format = F;
+    #[inline(always)]
+    fn into_depth(self) -> Option<&'b mut DepthBuffer<'a, F>> {
+        self
+    }
+    #[inline(always)]
+    fn draw_triangle<R: WSpan, D, V>(
+        &mut self,
+        r: &mut Rasterizer<R>,
+        target: &mut D,
+        v: &[V; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+        V: VertexInput<Color = D::Color>,
+    {
+        match self {
+            Some(d) => F::draw_into(r, target, d, v),
+            None => r.draw_packed::<F, D>(target, None, v),
+        }
+    }
+}
+
+/// No depth buffer: depth off, every covered pixel in the depth range drawn, in the colour target's rows and
+/// columns.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NoDepth;
+
+impl IntoDepth<'static, 'static> for NoDepth {
+    type Format = W16;
+    #[inline(always)]
+    fn into_depth(self) -> Option<&'static mut DepthBuffer<'static, W16>> {
+        None
+    }
+    #[inline(always)]
+    fn draw_triangle<R: WSpan, D, V>(
+        &mut self,
+        r: &mut Rasterizer<R>,
+        target: &mut D,
+        v: &[V; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+        V: VertexInput<Color = D::Color>,
+    {
+        r.draw_packed::<W16, D>(target, None, v)
+    }
+}
+
+impl<R: WSpan> Rasterizer<R> {
+    /// Draws one flat-coloured triangle (the colour of its first vertex) into `target` and `depth`: a depth buffer
+    /// of any format (`&mut DepthBuffer<F>`), an `Option` of one, or [`NoDepth`] (depth off; the
+    /// rows and columns are then the target's). A W16 buffer with a per-pixel reciprocal ([`crate::recip::SpanRecip`]) takes the
+    /// fast tier's loops (or the exact tier's, with [`crate::recip::Exact`]); any other format or strategy the span
+    /// loop generic over both (`crate::packed`). The choice is the types', made at compile time: a firmware links
+    /// only the loops of the format and strategy it names. The depth test runs before any colour work for the pixel
+    /// (the Windows CE "Depth Buffering" docs): a passing pixel's colour is sent with its run. On an error nothing is
+    /// written, except for a failing `target` ([`Error::Target`] says what is left).
+    pub fn draw<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
+        &mut self,
+        target: &mut D,
+        depth: B,
+        v: &[impl VertexInput<Color = D::Color>; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        let mut depth = depth;
+        depth.draw_triangle(self, target, v)
+    }
+
+    /// [`Rasterizer::draw`] through the span loop generic over the format and the strategy whatever the format,
+    /// W16 included (which `draw` gives to its own loops where the strategy is a per-pixel reciprocal): the tests
+    /// compare the two on W16. Not for firmware.
+    #[doc(hidden)]
+    pub fn draw_generic<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
+        &mut self,
+        target: &mut D,
+        depth: B,
+        v: &[impl VertexInput<Color = D::Color>; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        self.draw_packed(target, depth.into_depth(), v)
+    }
+
+    /// Draws one point (the pixel containing it, at its own depth; never biased) into `depth` as
+    /// [`Rasterizer::draw`] takes it. On an error nothing is written, except for a failing `target`
+    /// ([`Error::Target`]).
+    pub fn draw_point<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
+        &mut self,
+        target: &mut D,
+        depth: B,
+        v: &impl VertexInput<Color = D::Color>,
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        self.point_any(target, depth.into_depth(), v)
+    }
+
+    /// Draws one line from `v[0]` to `v[1]` (flat, `v[0]`'s colour; never biased) into `depth` as
+    /// [`Rasterizer::draw`] takes it. On an error nothing is written, except for a failing `target`
+    /// ([`Error::Target`]).
+    ///
+    /// Points, lines and wireframe triangles (the Windows CE "Depth Buffering" docs' primitives), through the same `T` (RHW) path, the same
+    /// W strategy and the same depth test as solid triangles. Depth bias applies to wireframe triangles, never to points
+    /// or lines (the Windows CE "Depth Buffering" docs).
+    ///
+    /// Rules. A point covers the pixel that contains it, `(floor x, floor y)`, at its own depth. A line covers, for each
+    /// column (x-major, `|dx| >= |dy|`) or row (y-major) whose pixel centre lies in `[start, end)` of the snapped
+    /// endpoints' major coordinate (ordered increasing), the pixel containing the line's point at that centre: one pixel
+    /// per major step, the upper endpoint excluded, so connected lines share no pixel. `T` along it is the line's exact
+    /// interpolation at the pixel centre, its step rounded once (as for triangles: at `k` steps it errs by at most
+    /// `(1 + k) / 2` units of `2^-F`). A wireframe triangle is culled like a solid one and draws its three edges with the
+    /// triangle's depth bias, in its first vertex's colour.
+    pub fn draw_line<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
+        &mut self,
+        target: &mut D,
+        depth: B,
+        v: &[impl VertexInput<Color = D::Color>; 2],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        self.line_any(target, depth.into_depth(), v)
+    }
+
+    /// Draws the three edges of a triangle, culled like a solid one, with its depth bias, into `depth` as
+    /// [`Rasterizer::draw`] takes it. On an error nothing is written, except for a failing `target`
+    /// ([`Error::Target`]).
+    pub fn draw_wireframe<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
+        &mut self,
+        target: &mut D,
+        depth: B,
+        v: &[impl VertexInput<Color = D::Color>; 3],
+    ) -> Result<Stats, Error>
+    where
+        D: DrawTarget,
+        D::Color: PixelColor,
+    {
+        self.wireframe_any(target, depth.into_depth(), v)
+    }
+}
