@@ -2,7 +2,7 @@
 //! Rogers, "W-Buffering in Direct3D" (NVIDIA) (`W_scaled = W / W_far * scale_factor`).
 
 use crate::format::{DepthFormat, Storage, W16};
-use crate::{Codec, DepthRange, Error};
+use crate::Error;
 
 /// The code of the far plane, and of a cleared buffer.
 pub const W16_FAR: u16 = u16::MAX;
@@ -70,7 +70,7 @@ impl<'a> DepthBuffer<'a, W16> {
     }
 }
 
-impl<'a, F: Codec> DepthBuffer<'a, F> {
+impl<'a, F: DepthFormat> DepthBuffer<'a, F> {
     /// A whole-frame buffer of format `F`; `data.len()` must be `width * height`.
     pub fn new_format(data: &'a mut [F::Word], width: u16, height: u16) -> Result<Self, Error> {
         Self::band_format(data, width, 0, height)
@@ -103,11 +103,10 @@ impl<'a, F: Codec> DepthBuffer<'a, F> {
         })
     }
 
-    /// Sets every pixel to the far plane's code for `range` (0 for reversed Z; a W16 buffer's far code, 65535, does
-    /// not depend on the range: [`DepthBuffer::clear`]).
-    pub fn clear_for(&mut self, range: &DepthRange) {
-        let (_, fm, fe) = crate::fixed::split(range.far()).unwrap_or((false, 0, 0));
-        self.data.fill(F::Word::from_code(F::far_code((fm, fe))));
+    /// Sets every pixel to `w` and the coarse bound (W16's, feature `coarse`) to the far code, which bounds any
+    /// content.
+    pub(crate) fn fill(&mut self, w: F::Word) {
+        self.data.fill(w);
         #[cfg(feature = "coarse")]
         {
             self.bound.seg.fill(W16_FAR);
@@ -200,12 +199,7 @@ impl<'a> DepthBuffer<'a, W16> {
 
     /// Sets every element to the far plane (and the coarse bound with it).
     pub fn clear(&mut self) {
-        self.data.fill(W16_FAR);
-        #[cfg(feature = "coarse")]
-        {
-            self.bound.seg.fill(W16_FAR);
-            self.bound.valid = true;
-        }
+        self.fill(W16_FAR);
     }
 
     /// A draw with `cmp` (and depth write `write`) may raise stored codes: stop using the coarse bound until the

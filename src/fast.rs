@@ -28,7 +28,7 @@
 
 use embedded_graphics_core::draw_target::DrawTarget;
 
-use crate::raster::Runs;
+use crate::runs::Runs;
 use crate::Error;
 
 /// Largest relative error of the fast tier's `x` against the exact `2^X / tau_exact` (`tau_exact` the unrounded
@@ -1026,6 +1026,32 @@ fn renormalise<const UP: bool>(v: &mut u64, dv: &mut i64, lz: &mut i32, x: &mut 
         *lz += 1;
         *x >>= 1;
         *dx >>= 1;
+    }
+}
+
+/// The leading zeros of `v != 0`, by [`bits64`] (`CLZ` where the core has one, an inline binary search where
+/// `leading_zeros` is a library call: the Cortex-M0 and RV32IMAC).
+#[inline(always)]
+pub(crate) fn clz32(v: u32) -> u32 {
+    64 - bits64(v as u64) - 32
+}
+
+/// The top 32 bits of `v != 0` and its leading zeros `l`: `v` is `m 2^(32 - l)`, truncated (below `2^-31`), with `m`
+/// in `[2^31, 2^32)`. 32-bit shifts only (a variable 64-bit shift is a library call on the 32-bit cores).
+#[inline(always)]
+pub(crate) fn top32(v: u64) -> (u32, i32) {
+    let (hi, lo) = ((v >> 32) as u32, v as u32);
+    if hi != 0 {
+        let l = clz32(hi);
+        let m = if l == 0 {
+            hi
+        } else {
+            (hi << l) | (lo >> (32 - l))
+        };
+        (m, l as i32)
+    } else {
+        let l = clz32(lo);
+        (lo << l, 32 + l as i32)
     }
 }
 

@@ -7,8 +7,9 @@
 //! The depth arithmetic is exact on either input (the product `rhw * W_far` is formed from the mantissas), so a
 //! fixed-point vertex whose values equal an f32 vertex's gives the same pixels and the same codes.
 
+use crate::edge::Sub;
 use crate::fixed::split;
-use crate::raster::{Vertex, GUARD_BAND, SUBPIXEL_BITS};
+use crate::setup::{rows_of, Vertex, GUARD_BAND, SUBPIXEL_BITS};
 use crate::Error;
 pub use fixed::traits::Fixed;
 pub use fixed::types::{I24F8, U16F16, U1F31, U8F24};
@@ -30,7 +31,7 @@ pub trait VertexInput: sealed::Sealed + Copy {
     #[doc(hidden)]
     fn snapped_exact(&self) -> Result<(i32, i32, bool), Error>;
     /// `x - ox` and `y - oy` on the depth grid of `bits` fraction bits (round to nearest, ties to even; see
-    /// `crate::raster::depth_grid_bits`): the positions the depth plane goes through. Only called after
+    /// `crate::setup::depth_grid_bits`): the positions the depth plane goes through. Only called after
     /// [`VertexInput::snapped`] accepted the vertex, with an origin and `bits` that keep the results below `2^31`.
     #[doc(hidden)]
     fn depth_xy(&self, bits: u32, ox: i32, oy: i32) -> (i32, i32);
@@ -348,6 +349,17 @@ impl<C: Copy, R: Fixed<Bits = u32>> VertexInput for FixedVertex<C, R> {
     fn color(&self) -> C {
         self.color
     }
+}
+
+/// The frame rows `(first, last)` a triangle can cover (inclusive; empty when `first > last`), after snapping:
+/// for binning triangles into bands without setting them up. Errors as [`crate::Rasterizer::draw`] for x and y.
+pub fn row_range<V: VertexInput>(v: &[V; 3]) -> Result<(i32, i32), Error> {
+    let mut p = [Sub { x: 0, y: 0 }; 3];
+    for (q, v) in p.iter_mut().zip(v) {
+        let (x, y) = v.snapped()?;
+        *q = Sub { x, y };
+    }
+    Ok(rows_of(&p))
 }
 
 #[cfg(test)]

@@ -121,8 +121,10 @@ pub mod packed;
 pub mod projection;
 mod raster;
 pub mod recip;
+mod runs;
 #[cfg(feature = "scenes")]
 pub mod scenes;
+mod setup;
 mod small;
 mod state;
 pub mod target;
@@ -145,10 +147,10 @@ pub use depth::bound_len;
 pub use depth::{DepthBuffer, DepthStore, W16_FAR};
 pub use draw::{IntoDepth, NoDepth};
 pub use error::Error;
+pub use input::row_range;
 pub use input::{FixedVertex, VertexInput};
 pub use packed::{Codec, Resolved};
-pub use raster::{
-    depth_grid_bits, row_range, Rasterizer, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS,
-};
+pub use raster::Rasterizer;
+pub use setup::{depth_grid_bits, Stats, Vertex, GUARD_BAND, SUBPIXEL_BITS};
 pub use state::{Compare, Cull, DepthMode, DepthRange, RenderState, MAX_T};
 pub use target::ColorBand;

@@ -110,17 +110,7 @@ pub struct Mesh<'a, C> {
     pub colors: Colors<'a, C>,
 }
 
-/// A transformed vertex: screen `x`, `y` and `rhw` when it is in front of the near plane and inside the guard band;
-/// `rhw == 0` marks the others (the triangles using them are clipped from their positions). 12 bytes.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Projected {
-    /// Pixels, right.
-    pub x: f32,
-    /// Pixels, down.
-    pub y: f32,
-    /// `1 / W`, or 0 for a vertex that needs clipping.
-    pub rhw: f32,
-}
+pub use crate::transform::Projected;
 
 /// A mesh transformed for one frame ([`Rasterizer::transform_mesh`]): draw it into each band with
 /// [`Rasterizer::draw_mesh_frame`].
@@ -245,7 +235,7 @@ impl<'a, C: Copy> DrawFrame<'a, C> for CachedFrame<'a, C> {}
 
 mod sealed {
     use super::{Cache, CachedFrame, MeshFrame, DECLINED};
-    use crate::raster::{NoMemo, TMemo};
+    use crate::setup::{NoMemo, TMemo};
 
     /// Triangle `k`'s memo in a band whose last row is `last`: values from the cache, and kept for a triangle that
     /// reaches further down.
@@ -268,7 +258,7 @@ mod sealed {
         }
     }
 
-    /// The frame, and a triangle's memo ([`crate::raster::TMemo`]) in a band.
+    /// The frame, and a triangle's memo ([`crate::setup::TMemo`]) in a band.
     pub trait Frame<'a, C> {
         type Memo<'m>: TMemo
         where
@@ -1346,8 +1336,8 @@ mod tests {
             vec![0u16; w as usize * h as usize],
             vec![0u16; w as usize * h as usize],
         );
-        crate::raster::T_AT_SNAPPED_CALLS.with(|c| c.borrow_mut().clear());
-        crate::raster::FAST_T_USED.with(|c| c.borrow_mut().clear());
+        crate::setup::T_AT_SNAPPED_CALLS.with(|c| c.borrow_mut().clear());
+        crate::setup::FAST_T_USED.with(|c| c.borrow_mut().clear());
         let mut y0s: Vec<u16> = (0..h).step_by(rows as usize).collect();
         if reverse {
             y0s.reverse();
@@ -1391,11 +1381,11 @@ mod tests {
             Some(c) => bands(&mut drawer(&frame.with_plane_cache(c), rs, alternate)),
             None => bands(&mut drawer(&frame, rs, alternate)),
         }
-        let mut calls = crate::raster::T_AT_SNAPPED_CALLS.with(|c| c.take());
+        let mut calls = crate::setup::T_AT_SNAPPED_CALLS.with(|c| c.take());
         let n = calls.len();
         calls.sort_unstable();
         calls.dedup();
-        let mut used = crate::raster::FAST_T_USED.with(|c| c.take());
+        let mut used = crate::setup::FAST_T_USED.with(|c| c.take());
         used.sort_unstable();
         used.dedup();
         (color, depth, n, calls.len(), used)

@@ -24,11 +24,12 @@ use crate::fixed::{div_u128, split};
 use crate::format::{DepthFormat, W24FScaled, LZ16, RZ32F, W16, W16F, W24F, W32F, Z16, Z24, Z32F};
 use crate::input::VertexInput;
 #[cfg(feature = "bias")]
-use crate::raster::slope_bias;
-use crate::raster::{div_round, Plane, Runs, Stats};
-#[cfg(feature = "bias")]
 use crate::recip::exact_u;
 use crate::recip::WSpan;
+use crate::runs::Runs;
+#[cfg(feature = "bias")]
+use crate::setup::slope_bias;
+use crate::setup::{div_round, Plane, Stats};
 use crate::state::{DepthMode, ZConst};
 use crate::{DepthBuffer, Error, Rasterizer};
 
@@ -238,6 +239,15 @@ fn linear_z60(zc: &ZConst, t: i64, frac: u32) -> i64 {
     // |z| < 2^63 (rz60 is saturated to 2^62) and u <= 2^64 after the clamp, so the product fits i128
     let u = div_u128((1u128 << (62 + frac).min(125)) + (t as u128 >> 1), t).min(1 << 64) as i128;
     ((z * u) >> 62).clamp(-(1 << 61), 1 << 61) as i64
+}
+
+impl<F: Codec> DepthBuffer<'_, F> {
+    /// Sets every pixel to the far plane's code for `range` (0 for reversed Z; a W16 buffer's far code, 65535, does
+    /// not depend on the range: [`DepthBuffer::clear`]).
+    pub fn clear_for(&mut self, range: &crate::DepthRange) {
+        let (_, fm, fe) = split(range.far()).unwrap_or((false, 0, 0));
+        self.fill(crate::format::Storage::from_code(F::far_code((fm, fe))));
+    }
 }
 
 /// The depth buffering a draw gets after Dunlop's "Using W-Buffers" capability check (see [`DepthMode`]).
@@ -875,8 +885,9 @@ mod zconst_tests {
 #[cfg(test)]
 mod code_tests {
     use crate::format::{DepthFormat, Storage, W16F, W32F};
-    use crate::raster::{Rasterizer, Vertex};
+    use crate::raster::Rasterizer;
     use crate::recip::Fast;
+    use crate::setup::Vertex;
     use crate::DepthBuffer;
     use crate::{Codec, RenderState};
     use embedded_graphics_core::pixelcolor::BinaryColor;

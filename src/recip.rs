@@ -503,7 +503,7 @@ impl<R: SpanRecip> WSpan for R {
         D: embedded_graphics_core::draw_target::DrawTarget,
         D::Color: embedded_graphics_core::pixelcolor::PixelColor,
     {
-        r.draw_memo(target, depth, v, &mut crate::raster::NoMemo)
+        r.draw_memo(target, depth, v, &mut crate::setup::NoMemo)
     }
     #[inline(always)]
     fn walk<E>(

@@ -34,7 +34,7 @@
 //! `s <= 31` at every pixel.
 //!
 //! **Which plane.** The `T_k` are the vertices' own where they lie on the snap grid; off it, the depth-grid plane's
-//! `T` at the snapped vertices (`crate::raster::t_at_snapped`, below `T_min 2^-35` off), so that `S` interpolates the
+//! `T` at the snapped vertices (`crate::setup::t_at_snapped`, below `T_min 2^-35` off), so that `S` interpolates the
 //! plane through the vertices as given (to the depth grid), not the snapped ones.
 //!
 //! **Error** (relative, of the computed code's value against the exact `65535 2^F / T` of that plane):
@@ -62,7 +62,7 @@ use crate::fast::FAST_MAX_REL_ERROR;
 use crate::fast::{
     bits64 as bits, fresh61, lz_small, mul_hi, mul_wide, shl64, shr64, smul_wide, wmul, FreshSeed,
 };
-use crate::raster::{rows_of, Setup, Stats, SUBPIXEL_BITS};
+use crate::setup::{rows_of, Setup, Stats, SUBPIXEL_BITS};
 use crate::state::{Cull, RenderState};
 use crate::Error;
 
@@ -694,8 +694,9 @@ fn partial<D: DrawTarget>(
 mod tests {
     use super::*;
     use crate::fast::{Chord, Divide};
-    use crate::raster::{t_at_snapped, Rasterizer, Vertex};
+    use crate::raster::Rasterizer;
     use crate::recip::Fast;
+    use crate::setup::{t_at_snapped, Vertex};
     use embedded_graphics_core::pixelcolor::BinaryColor;
     use embedded_graphics_core::prelude::{OriginDimensions, Pixel};
     use std::vec;

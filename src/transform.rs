@@ -24,11 +24,22 @@
 //! (`host-tests/tests/mesh.rs`) allow for.
 
 use crate::clip::{Planes, CLIP_BAND};
-use crate::fast::{bits64, fresh61, mul_wide, smul_wide, Chord};
+use crate::fast::{bits64, clz32, fresh61, mul_wide, smul_wide, top32, Chord};
 use crate::fixed::{round_shift, split};
-use crate::mesh::Projected;
 use crate::projection::Mat4;
 use crate::Error;
+
+/// A transformed vertex: screen `x`, `y` and `rhw` when it is in front of the near plane and inside the guard band;
+/// `rhw == 0` marks the others (the triangles using them are clipped from their positions). 12 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Projected {
+    /// Pixels, right.
+    pub x: f32,
+    /// Pixels, down.
+    pub y: f32,
+    /// `1 / W`, or 0 for a vertex that needs clipping.
+    pub rhw: f32,
+}
 
 /// One output row: `A_j` for the three coordinates, `T`, and the row's exponent `e`.
 #[derive(Clone, Copy, Debug)]
@@ -205,32 +216,6 @@ fn to_31(v: f32, s: i32) -> i32 {
         -(r as i32)
     } else {
         r as i32
-    }
-}
-
-/// The leading zeros of `v != 0`, by [`bits64`] (`CLZ` where the core has one, an inline binary search where
-/// `leading_zeros` is a library call: the Cortex-M0 and RV32IMAC).
-#[inline(always)]
-fn clz32(v: u32) -> u32 {
-    64 - bits64(v as u64) - 32
-}
-
-/// The top 32 bits of `v != 0` and its leading zeros `l`: `v` is `m 2^(32 - l)`, truncated (below `2^-31`), with `m`
-/// in `[2^31, 2^32)`. 32-bit shifts only (a variable 64-bit shift is a library call on the 32-bit cores).
-#[inline(always)]
-pub(crate) fn top32(v: u64) -> (u32, i32) {
-    let (hi, lo) = ((v >> 32) as u32, v as u32);
-    if hi != 0 {
-        let l = clz32(hi);
-        let m = if l == 0 {
-            hi
-        } else {
-            (hi << l) | (lo >> (32 - l))
-        };
-        (m, l as i32)
-    } else {
-        let l = clz32(lo);
-        (lo << l, 32 + l as i32)
     }
 }
 

@@ -1,0 +1,702 @@
+//! The set-up stage, below every span loop: the vertex and its snapped, checked form ([`Setup`]), the depth grid
+//! ([`depth_grid_bits`]) and the depth-grid plane's `T` at the snapped vertices ([`t_at_snapped`], the fast tier's way
+//! to it), the exact `T` plane ([`Plane`]), the rows a triangle covers, and the colour runs and counts every loop
+//! reports through ([`Stats`]; the colour runs: `crate::runs`). The W16 loops (`crate::raster`, `crate::fast`, `crate::small`) and the
+//! loop generic over the format (`crate::packed`) build on it; it imports none of them.
+
+use crate::edge::Sub;
+use crate::fixed::{div_u128, Divisor};
+#[cfg(feature = "bias")]
+use crate::state::RenderState;
+
+/// Fraction bits of snapped x and y (Direct3D 11's 16.8): coverage (the edge functions) uses the snapped vertices.
+pub const SUBPIXEL_BITS: u32 = 8;
+
+/// Fraction bits of the depth grid of a triangle whose snapped box spans `extent` whole pixels (its larger side,
+/// `0..=8192`): `31 - bits(extent + 2)`, from 29 (a box within one pixel) down to 17 (the guard band). The depth plane
+/// (and the colour planes) go through the vertices as given, rounded to this grid relative to the box's first pixel,
+/// not through the snapped ones: positions then fit 31 bits (the exact plane solve's budget). An f32 coordinate of
+/// magnitude `2^(23 - bits)` px or more lies on the grid exactly (`2^-6` px for a box under 6 px, 64 px for the
+/// largest boxes); a smaller one moves by at most half a grid step. Vertices on the 16.8 snap grid (integer and
+/// fixed-point input, most meshes' pixel-aligned vertices) give the same plane either way and skip this.
+pub const fn depth_grid_bits(extent: i32) -> u32 {
+    31 - (32 - ((extent + 2) as u32).leading_zeros())
+}
+
+/// [`depth_grid_bits`] for the set-up, for `extent` in `0..=8192`: the same value (tested), with the crate's bit count
+/// ([`crate::fast::bits64`]) instead of `leading_zeros`, a library call on the cores without `CLZ`.
+#[inline(always)]
+pub(crate) fn grid_bits(extent: i32) -> u32 {
+    31 - crate::fast::bits64((extent + 2) as u32 as u64)
+}
+/// Vertices must have `|x|, |y| < GUARD_BAND` pixels (see ARCHITECTURE.md for why this is safe in i64).
+pub const GUARD_BAND: i32 = 4096;
+
+/// A transformed-and-lit vertex, like Direct3D's TLVERTEX: `x`, `y` in pixels (pixel centres at `i + 0.5`), `z`,
+/// `rhw = 1/W`, and a colour. Every depth mode takes its depth from `rhw` and the depth range (Z modes compute D3D's
+/// `Z = f/(f-n) (1 - n rhw)`, which is what a D3D projection puts in `z`), so `z` is only checked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Vertex<C> {
+    /// Pixels, right.
+    pub x: f32,
+    /// Pixels, down.
+    pub y: f32,
+    /// Post-projection z (checked for finiteness; depth comes from `rhw`).
+    pub z: f32,
+    /// `1 / W`, `W` the eye-space depth; must be > 0.
+    pub rhw: f32,
+    /// Colour.
+    pub color: C,
+}
+
+impl<C> Vertex<C> {
+    /// A vertex at `(x, y)` with eye-space depth `w` (`rhw = 1/w`, `z = 0`).
+    pub fn new(x: f32, y: f32, w: f32, color: C) -> Self {
+        Vertex {
+            x,
+            y,
+            z: 0.0,
+            rhw: 1.0 / w,
+            color,
+        }
+    }
+}
+
+/// What one draw call did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Covered pixels inside the buffer's rows and the frame's columns (passing the depth test or not).
+    pub fragments: u32,
+    /// Pixels that passed the range and depth tests and were written.
+    pub written: u32,
+    /// Triangles culled (zero snapped area or by winding).
+    pub culled: u32,
+}
+
+impl core::ops::AddAssign for Stats {
+    fn add_assign(&mut self, o: Stats) {
+        self.fragments += o.fragments;
+        self.written += o.written;
+        self.culled += o.culled;
+    }
+}
+
+/// A triangle after snapping and checks.
+pub(crate) struct Setup<const N: usize = 3> {
+    /// Snapped positions (coverage).
+    pub(crate) p: [Sub; N],
+    /// Whether every vertex lies on the snap grid: then `p` is the vertices as given, and `q` is not computed.
+    pub(crate) on_grid: bool,
+    /// Otherwise (triangles): positions on the depth grid of `dbits` fraction bits ([`depth_grid_bits`]) relative
+    /// to the pixel `dorigin` (the box's first column and row).
+    pub(crate) q: [Sub; N],
+    pub(crate) dbits: u32,
+    pub(crate) dorigin: (i32, i32),
+    /// The fast tier's depth-grid plane `T` at the snapped vertices ([`t_at_snapped`]), where computed and accepted.
+    pub(crate) fast_t: Option<[i64; 3]>,
+    pub(crate) t: [i64; N],
+    pub(crate) frac: u32,
+}
+
+/// Where [`crate::Rasterizer::draw_memo`] finds and leaves a triangle's [`t_at_snapped`] values.
+pub trait TMemo {
+    /// The values remembered for this triangle, if any.
+    fn get(&mut self) -> Option<Option<[i64; 3]>>;
+    /// This triangle's values, and its last row (the memo keeps them only for a triangle that reaches a later band).
+    fn put(&mut self, t: Option<[i64; 3]>, last_row: i32);
+}
+
+impl<M: TMemo> TMemo for Option<M> {
+    #[inline(always)]
+    fn get(&mut self) -> Option<Option<[i64; 3]>> {
+        self.as_mut().and_then(|m| m.get())
+    }
+    #[inline(always)]
+    fn put(&mut self, t: Option<[i64; 3]>, last_row: i32) {
+        if let Some(m) = self {
+            m.put(t, last_row);
+        }
+    }
+}
+
+/// No memo: every draw computes its values.
+pub struct NoMemo;
+
+impl TMemo for NoMemo {
+    #[inline(always)]
+    fn get(&mut self) -> Option<Option<[i64; 3]>> {
+        None
+    }
+    #[inline(always)]
+    fn put(&mut self, _: Option<[i64; 3]>, _: i32) {}
+}
+
+/// Rows whose pixel centre lies in the snapped vertices' y-range (possibly empty: first > last).
+pub(crate) fn rows_of(p: &[Sub; 3]) -> (i32, i32) {
+    let ymin = p[0].y.min(p[1].y).min(p[2].y);
+    let ymax = p[0].y.max(p[1].y).max(p[2].y);
+    // |y| < 2^20 sub-pixels (the guard band): no overflow in i32, and `>>` is the floor division.
+    let first = (ymin - 128 + 255) >> SUBPIXEL_BITS; // ceil((ymin - 128) / 256)
+    let last = (ymax - 128) >> SUBPIXEL_BITS;
+    (first, last)
+}
+
+/// Rounded `n / d` for `d > 0` (ties away from zero).
+pub(crate) fn div_round(n: i128, d: i128) -> i128 {
+    let (neg, a) = (n < 0, n.unsigned_abs() + (d as u128) / 2);
+    let q = div_u128(a, d as u64);
+    if neg {
+        -(q as i128)
+    } else {
+        q as i128
+    }
+}
+
+/// Positions of the oriented triangle, the reference pixel of its planes (column `i_ref`, row `j_ref`: the box's
+/// left column and the triangle's first row, whatever the buffer), and the first row walked, `j0`.
+///
+/// The planes are rounded at the reference pixel and stepped from there to `j0` with their rounded row step, so a
+/// pixel's value does not depend on which band (or buffer) walks it: a frame drawn in bands equals the frame drawn
+/// whole, codes and range tests included. (A fuzz finding: with the planes rounded at each band's first row, pixels
+/// exactly on the near plane flipped between bands.)
+pub(crate) struct Geom {
+    /// Snapped positions (coverage; and the bias's slope), and their doubled area (positive).
+    pub(crate) p: [Sub; 3],
+    pub(crate) area: i64,
+    /// The positions the planes go through, in units of `2^-dbits` px from the pixel `dorigin`, and their doubled
+    /// signed area in those units (nonzero; negative when rounding flipped the triangle against `p`'s orientation):
+    /// the depth grid's, or the snapped ones where the vertices lie on the snap grid, where the fast tier solves
+    /// through them with [`t_at_snapped`]'s values, or where [`depth_plane`] refuses.
+    pub(crate) dq: [Sub; 3],
+    pub(crate) darea: i64,
+    pub(crate) dbits: u32,
+    /// The pixel `dq` is relative to.
+    pub(crate) dorigin: (i32, i32),
+    pub(crate) i_ref: i64,
+    pub(crate) j_ref: i32,
+    pub(crate) j0: i32,
+}
+
+/// The snap's rounding against the depth grid at one vertex, `r = p - q` in units of the grid (`bits` fraction bits,
+/// relative to the pixel `origin`): the snapped position there is below `2^31` units (the grid's choice), and
+/// `|r|` at most `2^(bits - 9)` (half a sub-pixel plus half a grid step), so `i32` throughout.
+#[inline(always)]
+pub(crate) fn snap_rounding(p: Sub, q: Sub, bits: u32, (ox, oy): (i32, i32)) -> (i32, i32) {
+    let up = bits - SUBPIXEL_BITS;
+    (
+        ((p.x - (ox << SUBPIXEL_BITS)) << up).wrapping_sub(q.x),
+        ((p.y - (oy << SUBPIXEL_BITS)) << up).wrapping_sub(q.y),
+    )
+}
+
+/// The doubled signed area of the depth-grid triangle `q` (oriented like `p`), if the plane of `t` through it can be
+/// walked (`Err` otherwise: see below).
+///
+/// A covered pixel lies in the snapped triangle `p`, so it is a convex combination of the `p_k = q_k - r_k` (`r_k`
+/// the rounding of the snap against the depth grid): `P = Q - R` with `Q` in `q`'s triangle and each coordinate of
+/// `R` at most `r = max |r_k|`. So its `T` is within `(|T_x| + |T_y|) r` of a value in `[T_min, T_max]` (`T_x`, `T_y`
+/// the plane's gradient per grid unit). Accepted when `(|gx| + |gy|) r <= 2^61 |area|` (`T < 2^61`): every covered
+/// pixel's `T` then lies in `(-2^61, 2^62)` and its walked value is exact modulo `2^64` (module doc); the range test
+/// rejects the extrapolated pixels whose `T` leaves `[2^F, T_near]`. Otherwise `Err(Some(e))`: with `T` shifted
+/// right by `e` bits (`F - e` fraction bits, the plane's rounding then `2^e` times coarser) it is accepted; `Err(None)`
+/// for a degenerate `q`. Ranges: positions below `2^31` units (the grid's choice), so differences below `2^31`,
+/// `|g| < 2^93`, `r <= 2^(bits - 9) < 2^21`, `|area| < 2^63`.
+#[inline(never)] // once per triangle: out of line, one copy (flash)
+pub(crate) fn depth_plane(
+    p: &[Sub; 3],
+    q: &[Sub; 3],
+    t: &[i64; 3],
+    bits: u32,
+    (ox, oy): (i32, i32),
+) -> Result<i64, Option<u32>> {
+    let [q0, q1, q2] = *q;
+    let (e1x, e1y) = ((q1.x - q0.x) as i128, (q1.y - q0.y) as i128);
+    let (e2x, e2y) = ((q2.x - q0.x) as i128, (q2.y - q0.y) as i128);
+    let area = e1x * e2y - e2x * e1y;
+    if area == 0 {
+        return Err(None);
+    }
+    let (d1, d2) = (t[1] as i128 - t[0] as i128, t[2] as i128 - t[0] as i128);
+    let gx = d1 * e2y - d2 * e1y;
+    let gy = d2 * e1x - d1 * e2x;
+    let r = (0..3)
+        .map(|k| {
+            let (rx, ry) = snap_rounding(p[k], q[k], bits, (ox, oy));
+            rx.unsigned_abs().max(ry.unsigned_abs())
+        })
+        .max()
+        .unwrap_or(0) as i128;
+    let (lhs, rhs) = ((gx.abs() + gy.abs()) * r, area.abs() << 61);
+    if lhs <= rhs {
+        return Ok(area as i64); // below 2^63
+    }
+    // lhs < rhs 2^e; one more bit for the rounding of the shifted `T` (which moves `g` by at most `2^32`).
+    Err(Some(rhs.leading_zeros() - lhs.leading_zeros() + 2))
+}
+
+/// The fast tier's way to the depth-grid plane without solving it: its `T` at the three snapped vertices, so that the
+/// plane through `(p_k, T_q(p_k))` (what the fast set-ups solve, from the snapped positions they already have) is the
+/// depth-grid plane itself (an affine function is fixed by three points).
+///
+/// `T_q(p_k) = t_k + grad T_q . r_k` with `r_k = p_k - q_k` (the snap's rounding against the depth grid, below
+/// `2^(bits - 9) <= 2^21` units). The gradient's numerators `(gx, gy)` are exact (`i64 x i32` products from two
+/// 32-bit multiplies each, below `2^94`); each is divided by the doubled area with its top 32 bits (`2^-31`) and one
+/// 32-bit reciprocal of the area's top 32 bits ([`crate::fast::fresh61`]: `2^-27.6`, the area's truncation `2^-31`), kept to 32
+/// bits (`2^-28`): below `2^-26.5` relative; then times `r` exactly, truncated (one unit). Accepted when
+/// `|c_k|`'s bound is at most `T_min / 2^9` for every `k` (a plane gentle over the snap's 1/512 px), so the corrected
+/// values err by below `T_min 2^-35`, far inside both fast set-ups' margins; `None` otherwise (the exact solve then
+/// runs). 32- and 64-bit arithmetic only (no 128-bit product: those are library calls on the 32-bit cores). Only for
+/// vertices off the snap grid.
+///
+/// Two ways to these values, the same bound: [`t_at_snapped_wide`] (described here) and [`t_at_snapped_narrow`],
+/// which falls back to the wide way where it cannot vouch for its result. The narrow way is `NARROW`, the choice of
+/// the strategy that seeds its reciprocal by division ([`crate::recip::FastDiv`], for cores with `UMULL` and a divider):
+/// on the Cortex-M4 it takes about 73% of the wide way's instructions (550 against 753 a call on W4: 3.6% fewer a
+/// frame). On the Cortex-M0, whose 64-bit products are four `MULS` each, it is the dearer (1,491 against 1,241
+/// instructions a call on the terrain), so [`crate::recip::Fast`] keeps the wide way. The two round differently within
+/// the bound, so the strategy decides, and each strategy's frames stay the same on every core.
+#[inline(never)] // once per triangle: out of line, one copy (flash)
+pub(crate) fn t_at_snapped<const NARROW: bool>(s: &Setup) -> Option<[i64; 3]> {
+    #[cfg(test)]
+    T_AT_SNAPPED_CALLS.with(|c| c.borrow_mut().push(s.p.map(|p| (p.x, p.y))));
+    if !NARROW {
+        return t_at_snapped_wide(s);
+    }
+    match t_at_snapped_narrow(s) {
+        Narrow::Done(t) => Some(t),
+        Narrow::Steep => None,
+        Narrow::Unsure => t_at_snapped_wide(s),
+    }
+}
+
+#[cfg(test)]
+std::thread_local! {
+    /// The snapped vertices of each call of [`t_at_snapped`] on this thread (tests of the mesh's plane cache count
+    /// what it saves).
+    pub(crate) static T_AT_SNAPPED_CALLS: core::cell::RefCell<std::vec::Vec<[(i32, i32); 3]>> =
+        const { core::cell::RefCell::new(std::vec::Vec::new()) };
+    /// The snapped vertices and the depth-grid values of each draw that used them (computed or remembered).
+    #[allow(clippy::type_complexity)]
+    pub(crate) static FAST_T_USED: core::cell::RefCell<std::vec::Vec<([(i32, i32); 3], Option<[i64; 3]>)>> =
+        const { core::cell::RefCell::new(std::vec::Vec::new()) };
+}
+
+/// What [`t_at_snapped_narrow`] found.
+pub(crate) enum Narrow {
+    /// The values, within the bound.
+    Done([i64; 3]),
+    /// Some `|c_k|` is certainly above `T_min / 2^9`: [`t_at_snapped_wide`], whose bound on `|c_k|` is an upper
+    /// bound, would decline too.
+    Steep,
+    /// It cannot vouch for its result: [`t_at_snapped_wide`] decides.
+    Unsure,
+}
+
+/// `floor(v / 2^s)` for `s <= 40` whose result fits `i32`, from 32-bit shifts (a variable 64-bit shift is a library
+/// call on the 32-bit cores).
+#[inline(always)]
+fn sar_to_i32(v: i64, s: u32) -> i32 {
+    let (hi, lo) = ((v >> 32) as i32, v as u32);
+    if s == 0 {
+        lo as i32
+    } else if s >= 32 {
+        hi >> (s - 32)
+    } else {
+        ((hi << (32 - s)) as u32 | (lo >> s)) as i32
+    }
+}
+
+/// `floor(v / 2^s)` for any `s` (0 from 64 on), from 32-bit shifts ([`crate::fast::shr_pieces`]).
+#[inline(always)]
+fn shr_u64(v: u64, s: u32) -> u64 {
+    if s < 64 {
+        crate::fast::shr_pieces(v, s)
+    } else {
+        0
+    }
+}
+
+/// [`t_at_snapped`] in 32- and 64-bit pieces with a bound checked per triangle: the values ([`Narrow::Done`]), a plane
+/// certainly too steep ([`Narrow::Steep`]), or [`Narrow::Unsure`] where the bound is not small enough, and the caller
+/// then takes [`t_at_snapped_wide`].
+///
+/// `c_k = (gx rx_k + gy ry_k) / A` with the gradient's numerators `gx = d1 e2y - d2 e1y`, `gy = d2 e1x - d1 e2x`
+/// (`d_i = t_i - t_0`, `e_i = q_i - q_0`, `A` the doubled area, exact in `i64`). Here:
+/// - `d_i = D_i 2^sd + rho_i` (`D_i` the floor, `|D_i| <= 2^30`, `0 <= rho_i < 2^sd`);
+/// - `g' = D1 e2y - D2 e1y` (and `gy'`) exact in `i64` (below `2^62`), `g' = G 2^su + sigma` (`|G| <= 2^30`,
+///   `0 <= sigma < 2^su`);
+/// - `N_k = Gx rx_k + Gy ry_k` exact (below `2^52`); `c~_k = N_k 2^(sd + su) / A`.
+///
+/// Then `c_k - c~_k = (2^sd (sigma_x rx + sigma_y ry) + (rho1 e2y - rho2 e1y) rx + (rho2 e1x - rho1 e2x) ry) / A`,
+/// so `|c_k - c~_k| <= 2^sd (2^su + W) R / |A|` with `W = max(|e1y| + |e2y|, |e1x| + |e2x|)` and
+/// `R = max_k (|rx_k| + |ry_k|)`. Taken only when that is at most `T_min 2^-36` (`T_min >= 2^lt`; compared exactly in
+/// integers). `c~_k` is formed as `top32(|N_k|) x fresh61(top32(|A|))` (a 64-bit product, then a shift):
+/// truncations `2^-31` (each top) and the reciprocal `2^-27.9` (`Chord`, the same on every core and strategy), so
+/// within `2^-27.7 |c~_k|` plus one unit of the final shift. Accepted only when every computed `|c_k|` is at most
+/// `lim - lim / 2^8` (`lim = T_min / 2^9`), so the exact `|c_k|` is below `lim` as [`t_at_snapped`] asks, and
+/// `T_min >= 2^40`. Error: `T_min (2^-36 + 2^-9 2^-27.7) + 1 <= T_min (1.455 + 1.1 + 0.09) 10^-11 < T_min 2^-35`
+/// (`2.91 10^-11`), the bound [`t_at_snapped`] states.
+#[inline(always)]
+pub(crate) fn t_at_snapped_narrow(s: &Setup) -> Narrow {
+    use crate::fast::{bits64, fresh61, mul_wide, smul_wide, Chord};
+    let (p, q, t) = (s.p, s.q, s.t);
+    let [q0, q1, q2] = q;
+    let (e1x, e1y) = (q1.x.wrapping_sub(q0.x), q1.y.wrapping_sub(q0.y));
+    let (e2x, e2y) = (q2.x.wrapping_sub(q0.x), q2.y.wrapping_sub(q0.y));
+    // Differences below 2^31: the doubled area below 2^63.
+    let area = smul_wide(e1x, e2y) - smul_wide(e2x, e1y);
+    let t_min = t[0].min(t[1]).min(t[2]);
+    if area == 0 || t_min < 1 << 40 {
+        return Narrow::Unsure;
+    }
+    let lt = bits64(t_min as u64) as i32 - 1; // T_min >= 2^lt
+    let (d1, d2) = (t[1] - t[0], t[2] - t[0]); // below 2^61
+    let sd = (bits64(d1.unsigned_abs() | d2.unsigned_abs()) as i32 - 30).max(0) as u32;
+    let (dd1, dd2) = (sar_to_i32(d1, sd), sar_to_i32(d2, sd)); // |D| <= 2^30
+    let gx = smul_wide(dd1, e2y) - smul_wide(dd2, e1y); // below 2^62
+    let gy = smul_wide(dd2, e1x) - smul_wide(dd1, e2x);
+    let su = (bits64(gx.unsigned_abs() | gy.unsigned_abs()) as i32 - 30).max(0) as u32;
+    let (ggx, ggy) = (sar_to_i32(gx, su), sar_to_i32(gy, su)); // |G| <= 2^30
+    let r = [0, 1, 2].map(|k| snap_rounding(p[k], q[k], s.dbits, s.dorigin));
+    // R, below 2^22; W, below 2^32 (two magnitudes below 2^31 each).
+    let rr = r
+        .iter()
+        .map(|&(x, y)| x.unsigned_abs() + y.unsigned_abs())
+        .max()
+        .unwrap_or(0);
+    let w = (e1y.unsigned_abs() + e2y.unsigned_abs()).max(e1x.unsigned_abs() + e2x.unsigned_abs());
+    let a = area.unsigned_abs();
+    // 2^sd (2^su + W) R / |A| <= 2^(lt - 36), compared exactly: `bn = (2^su + W) R` below 2^55 (`su <= 32`), `a`
+    // below 2^63.
+    let bn = ((rr as u64) << su) + mul_wide(w, rr);
+    let k = lt - 36 - sd as i32;
+    let fits = if k >= 0 {
+        bits64(a) as i32 + k >= 56 || bn <= a << k
+    } else {
+        bits64(bn) as i32 - k < 64 && bn << -k <= a
+    };
+    if !fits {
+        return Narrow::Unsure;
+    }
+    let (am, al) = crate::fast::top32(a); // a = am 2^(32 - al), truncated
+    let x = fresh61::<Chord>(am) as u32; // about 2^61 / am, in (2^29, 2^30]
+    let lim = (t_min >> 9) as u64;
+    let ok = lim - (lim >> 8);
+    let mut out = t;
+    for k in 0..3 {
+        let (rx, ry) = r[k];
+        let n = smul_wide(ggx, rx) + smul_wide(ggy, ry); // below 2^52
+        if n == 0 {
+            continue;
+        }
+        let (nm, nl) = crate::fast::top32(n.unsigned_abs());
+        // c~ = nm x 2^(sd + su + al - nl - 61), the product in [2^60, 2^64).
+        let e = sd as i32 + su as i32 + al - nl - 61;
+        if e >= 0 {
+            return Narrow::Steep; // |c| >= 2^60 (1 - 2^-27)
+        }
+        let c = shr_u64(mul_wide(nm, x), (-e) as u32);
+        if c > ok {
+            // Steep for certain when even less its errors (below `2^-27 |c| + 2 + T_min 2^-36`) it exceeds `lim` by
+            // more than the wide way's own relative error (`2^-26.5`), so that way's value is above `lim` too.
+            return if c - (c >> 26) - 2 - (lim >> 20) > lim + (lim >> 19) {
+                Narrow::Steep
+            } else {
+                Narrow::Unsure
+            };
+        }
+        let c = if (n < 0) != (area < 0) {
+            -(c as i64)
+        } else {
+            c as i64
+        };
+        out[k] = t[k] + c;
+        if out[k] >= 1 << 61 || out[k] <= 0 {
+            return Narrow::Unsure;
+        }
+    }
+    Narrow::Done(out)
+}
+
+/// [`t_at_snapped`]'s exact gradient numerators (described there): `Fast`'s way, and `FastDiv`'s for the triangles
+/// [`t_at_snapped_narrow`] cannot vouch for (slivers, steep planes). Out of line: one copy for both (flash).
+#[inline(never)]
+pub(crate) fn t_at_snapped_wide(s: &Setup) -> Option<[i64; 3]> {
+    use crate::fast::{bits64, fresh61, mul_wide, shl64, shr64, smul_wide, Chord};
+    let (p, q, t) = (s.p, s.q, s.t);
+    // `a b` exactly for `|a| < 2^63`, `|b| < 2^31`, as (sign, magnitude): two 32 x 32 -> 64 products.
+    #[inline(always)]
+    fn mul_wide_signed(a: i64, b: i32) -> (bool, u128) {
+        let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
+        let m = ((mul_wide((ua >> 32) as u32, ub) as u128) << 32) + mul_wide(ua as u32, ub) as u128;
+        ((a < 0) != (b < 0), m)
+    }
+    // `x - y` of two (sign, magnitude) pairs, as (sign, magnitude).
+    #[inline(always)]
+    fn sub((sx, x): (bool, u128), (sy, y): (bool, u128)) -> (bool, u128) {
+        if sx != sy {
+            (sx, x + y)
+        } else if x >= y {
+            (sx, x - y)
+        } else {
+            (!sx, y - x)
+        }
+    }
+    // `v` (nonzero, below 2^96) normalised to [2^31, 2^32) and the shift back: `v` is about `top 2^sh`, truncated by
+    // below `2^-31`.
+    #[inline(always)]
+    fn top(v: u128) -> (u32, i32) {
+        // Constant shifts of the u128 only (a variable one is a library call on the 32-bit cores): below 2^96, so
+        // `v >> 32` fits a u64 whenever `v` does not, and its truncation is inside the 2^-31 kept.
+        let (w, extra) = if (v >> 64) as u64 != 0 {
+            ((v >> 32) as u64, 32)
+        } else {
+            (v as u64, 0)
+        };
+        let b = bits64(w) as i32;
+        let n = if b <= 32 {
+            shl64(w, (32 - b) as u32)
+        } else {
+            shr64(w, (b - 32) as u32)
+        };
+        (n as u32, b - 32 + extra)
+    }
+    let [q0, q1, q2] = q;
+    let (e1x, e1y) = (q1.x.wrapping_sub(q0.x), q1.y.wrapping_sub(q0.y));
+    let (e2x, e2y) = (q2.x.wrapping_sub(q0.x), q2.y.wrapping_sub(q0.y));
+    // Differences below 2^31: each product below 2^62, the doubled area below 2^63 (products by `mul_wide`: the
+    // M0's four `MULS` rather than an `__aeabi_lmul` call).
+    let area = smul_wide(e1x, e2y) - smul_wide(e2x, e1y);
+    if area == 0 {
+        return None;
+    }
+    let a = area.unsigned_abs();
+    let la = 64 - bits64(a);
+    let m = (shl64(a, la) >> 32) as u32; // in [2^31, 2^32): a = m 2^(32 - la), truncated
+    let x = fresh61::<Chord>(m) as u32; // about 2^61 / m (set-up: one seed for every strategy)
+                                        // The gradient's numerators `g = (d1 e2y - d2 e1y, d2 e1x - d1 e2x)`, exact (below 2^94), each divided by the
+                                        // area as `gh x 2^(sg + la - 93)` (`gh x` below 2^62), kept as its top 32 bits `G` and exponent `sg + la - 61`.
+    let (d1, d2) = (t[1] - t[0], t[2] - t[0]);
+    let grad = |g: (bool, u128)| -> (bool, u32, i32) {
+        if g.1 == 0 {
+            return (false, 0, 0);
+        }
+        let (gh, sg) = top(g.1);
+        (
+            g.0 != (area < 0),
+            (mul_wide(gh, x) >> 32) as u32,
+            sg + la as i32 - 61,
+        )
+    };
+    let gx = grad(sub(mul_wide_signed(d1, e2y), mul_wide_signed(d2, e1y)));
+    let gy = grad(sub(mul_wide_signed(d2, e1x), mul_wide_signed(d1, e2x)));
+    // `c_k = grad . r_k` (`r_k` the snap's rounding against the grid, below 2^21): each term `G |r| 2^e`, `G |r|`
+    // below 2^53, with its truncation (`+ 1`) in the bound.
+    let term = |(neg, gm, e): (bool, u32, i32), r: i32| -> Option<(i64, u64)> {
+        if gm == 0 || r == 0 {
+            return Some((0, 0));
+        }
+        let v = mul_wide(gm, r.unsigned_abs());
+        let v = if e >= 0 {
+            if e >= 10 || shr64(v, (62 - e) as u32) != 0 {
+                return None; // a term of 2^62 or more
+            }
+            shl64(v, e as u32)
+        } else {
+            shr64(v, ((-e) as u32).min(63))
+        };
+        Some((
+            if neg != (r < 0) {
+                -(v as i64)
+            } else {
+                v as i64
+            },
+            v + 1,
+        ))
+    };
+    let t_min = t[0].min(t[1]).min(t[2]);
+    let lim = (t_min >> 9) as u64;
+    let mut out = t;
+    for k in 0..3 {
+        let (rx, ry) = snap_rounding(p[k], q[k], s.dbits, s.dorigin);
+        let (cx, bx) = term(gx, rx)?;
+        let (cy, by) = term(gy, ry)?;
+        if bx + by > lim {
+            return None;
+        }
+        out[k] = t[k] + cx + cy;
+        if out[k] >= 1 << 61 || out[k] <= 0 {
+            return None;
+        }
+    }
+    Some(out)
+}
+
+/// The fewest fraction bits a sliver's `T` is solved with (see [`depth_plane`]); below, the snapped plane.
+pub(crate) const MIN_FRAC: u32 = 8;
+
+/// `a b` exactly (two 32 x 32 -> 64 products).
+#[inline]
+pub(crate) fn mul_64_32(a: i64, b: i32) -> i128 {
+    use crate::fast::mul_wide;
+    let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
+    let m = ((mul_wide((ua >> 32) as u32, ub) as u128) << 32) + mul_wide(ua as u32, ub) as u128;
+    if (a < 0) != (b < 0) {
+        -(m as i128)
+    } else {
+        m as i128
+    }
+}
+
+/// `a b` exactly for `|a| < 2^96` (three 32 x 32 -> 64 products; the plane's gradients are below `2^94`).
+#[inline]
+pub(crate) fn mul_96_32(a: i128, b: i32) -> i128 {
+    use crate::fast::mul_wide;
+    debug_assert!(a.unsigned_abs() < 1 << 96);
+    let (ua, ub) = (a.unsigned_abs(), b.unsigned_abs());
+    let m = ((mul_wide((ua >> 64) as u32, ub) as u128) << 64)
+        + ((mul_wide((ua >> 32) as u32, ub) as u128) << 32)
+        + mul_wide(ua as u32, ub) as u128;
+    if (a < 0) != (b < 0) {
+        -(m as i128)
+    } else {
+        m as i128
+    }
+}
+
+/// A quantity linear in screen space: its value at `(i_ref, current row)` and its steps per column and row.
+#[derive(Clone, Copy)]
+pub(crate) struct Plane {
+    pub(crate) row: i64,
+    pub(crate) sx: i64,
+    pub(crate) sy: i64,
+}
+
+impl Plane {
+    /// Solves `V(X, Y) = V0 + (gx (X - X0) + gy (Y - Y0)) / area` exactly in i128 through the positions `g.dq`
+    /// (X, Y in units of `2^-dbits` px) and rounds the steps and the reference value once each. Steps may wrap for
+    /// slivers (see the module doc). Ranges (`|V| < 2^61`; positions, their differences and the offset of the
+    /// reference pixel below `2^31` units, by the choice of the grid): `|g| < 2^93`, the numerator below `2^125`,
+    /// `area < 2^63`.
+    pub(crate) fn solve(v: [i64; 3], g: &Geom) -> Plane {
+        let [p0, p1, p2] = g.dq;
+        // |v| < 2^61, so the differences fit i64; the products by 32-bit position differences are exact limb
+        // products (`mul_64_32`), where an i128 multiply is a chain of library calls on the 32-bit cores.
+        let (d1, d2) = (v[1] - v[0], v[2] - v[0]);
+        let mut gx = mul_64_32(d1, p2.y - p0.y) - mul_64_32(d2, p1.y - p0.y);
+        let mut gy = mul_64_32(d2, p1.x - p0.x) - mul_64_32(d1, p2.x - p0.x);
+        let mut area = g.darea as i128;
+        if area < 0 {
+            (gx, gy, area) = (-gx, -gy, -area);
+        }
+        let u = 1i128 << g.dbits;
+        let (rx, ry) = (
+            u * (g.i_ref - g.dorigin.0 as i64) as i128 + u / 2 - p0.x as i128,
+            u * (g.j_ref - g.dorigin.1) as i128 + u / 2 - p0.y as i128,
+        );
+        // The reference offset is below 2^31 units (the grid's choice): three limb products then; any other offset
+        // takes the general i128 product (the same exact value).
+        let num = match (i32::try_from(rx), i32::try_from(ry)) {
+            (Ok(x), Ok(y)) => mul_96_32(gx, x) + mul_96_32(gy, y),
+            _ => gx * rx + gy * ry,
+        };
+        // Three divisions by the area: its reciprocal once (exact quotients, `Divisor`).
+        let dv = Divisor::new(area as u64);
+        Plane {
+            row: (v[0] as i128 + dv.div_round(num)) as i64,
+            sx: dv.div_round(gx << g.dbits) as i64,
+            sy: dv.div_round(gy << g.dbits) as i64,
+        }
+        .at_row(g)
+    }
+    /// From the reference row to the first row walked, by whole row steps (what walking there would give).
+    #[inline]
+    fn at_row(mut self, g: &Geom) -> Plane {
+        self.row = self
+            .row
+            .wrapping_add(self.sy.wrapping_mul((g.j0 - g.j_ref) as i64));
+        self
+    }
+    /// The fast tier's plane of `T` for a small triangle (box under 127 px), from one 64-bit reciprocal of the
+    /// doubled area instead of three exact 128-bit divisions; `None` where its error bound does not hold (then the
+    /// exact solve runs).
+    ///
+    /// The vertices' `T` (below `2^61`) are rounded to `T' = T >> 16` (at most `2^15` off each, so at most `2^15` at any
+    /// point inside the triangle, a convex combination of them). With edge vectors below `2^15` sub-pixels the
+    /// gradients `g` of `T'` times the doubled area fit `i64` (`< 2^61`). `inv = floor(2^62 / area)`, and a step in
+    /// `T` per pixel is `floor(g inv / 2^38)`, below the exact `g 2^24 / area` by at most `eps = |g| 2^-38 + 1`.
+    /// The value at the reference pixel is `T'_0 2^16` plus the steps times its offset from vertex 0 (at most 128 px
+    /// each way), and a covered pixel is at most 127 px further: at most `510 eps + 1` from the steps.
+    /// Total, at any covered pixel: `2^15 + 510 (|g| 2^-38 + 1) + 1 < |g| 2^-29 + 2^16`. This is accepted when
+    /// `|gx| + |gy| <= T_min / 2^5` and `T_min >= 2^51` (`T_min` the smallest vertex `T`, a lower bound of every covered
+    /// pixel's): then the error is below `T_min (2^-34 + 2^-35) < 2^-33` relative, the exact solve's own bound on
+    /// these triangles. Steps must also fit: `|g| < area 2^38`.
+    pub(crate) fn solve_fast(v: [i64; 3], g: &Geom) -> Option<Plane> {
+        let [p0, p1, p2] = g.p;
+        let t_min = v[0].min(v[1]).min(v[2]);
+        if t_min < 1 << 51 {
+            return None;
+        }
+        let tp = v.map(|t| (t + (1 << 15)) >> 16);
+        let (d1, d2) = (tp[1] - tp[0], tp[2] - tp[0]);
+        let (e1x, e1y) = ((p1.x - p0.x) as i64, (p1.y - p0.y) as i64);
+        let (e2x, e2y) = ((p2.x - p0.x) as i64, (p2.y - p0.y) as i64);
+        let gx = d1 * e2y - d2 * e1y;
+        let gy = d2 * e1x - d1 * e2x;
+        let area = g.area as u64;
+        let (ax, ay) = (gx.unsigned_abs(), gy.unsigned_abs());
+        // `|g| < area 2^38`, written so that nothing overflows (`area << 38` would for areas above 2^26).
+        if ax + ay > (t_min >> 5) as u64 || (ax >> 38) >= area || (ay >> 38) >= area {
+            return None;
+        }
+        let inv = (1u64 << 62) / area;
+        let step = |g: i64| ((g as i128 * inv as i128) >> 38) as i64;
+        let (sx, sy) = (step(gx), step(gy));
+        let rx = 256 * g.i_ref + 128 - p0.x as i64;
+        let ry = 256 * g.j_ref as i64 + 128 - p0.y as i64;
+        let off = (sx as i128 * rx as i128 + sy as i128 * ry as i128) >> 8;
+        Some(
+            Plane {
+                row: (tp[0] << 16).wrapping_add(off as i64),
+                sx,
+                sy,
+            }
+            .at_row(g),
+        )
+    }
+
+    #[inline(always)]
+    pub(crate) fn at(&self, di: i64) -> i64 {
+        self.row.wrapping_add(self.sx.wrapping_mul(di))
+    }
+    #[inline(always)]
+    pub(crate) fn next_row(&mut self) {
+        self.row = self.row.wrapping_add(self.sy);
+    }
+}
+
+/// Seed 001's offset `m * slope + constant` for a triangle whose vertices' codes are `c` (any format's codes, as
+/// `f32`): `m` is the larger of `|d code / dx|` and `|d code / dy|` (codes per pixel) of the plane through them.
+/// Rounded to the nearest code and clamped to `[-max, max]`.
+#[cfg(feature = "bias")]
+pub(crate) fn slope_bias(state: &RenderState, p: &[Sub; 3], c: [f32; 3], max: f32) -> i32 {
+    let (slope, constant) = (state.slope_scale_depth_bias, state.depth_bias);
+    let (dx1, dy1) = ((p[1].x - p[0].x) as f32, (p[1].y - p[0].y) as f32);
+    let (dx2, dy2) = ((p[2].x - p[0].x) as f32, (p[2].y - p[0].y) as f32);
+    let area = dx1 * dy2 - dx2 * dy1;
+    let (c1, c2) = (c[1] - c[0], c[2] - c[0]);
+    // per sub-pixel, times 256 per pixel
+    let gx = (c1 * dy2 - c2 * dy1) / area * 256.0;
+    let gy = (c2 * dx1 - c1 * dx2) / area * 256.0;
+    let m = if gx.abs() > gy.abs() {
+        gx.abs()
+    } else {
+        gy.abs()
+    };
+    let off = m * slope + constant;
+    if !off.is_finite() {
+        return 0;
+    }
+    let r = if off >= 0.0 { off + 0.5 } else { off - 0.5 };
+    r.clamp(-max, max) as i32
+}
