@@ -139,8 +139,8 @@ fn render_lean<R: SpanRecip>(
     )
 }
 
-/// Any format through `Rasterizer::draw` (W16 with a per-pixel reciprocal takes the tiers' own W16 loops, as a
-/// firmware's draw does; the other formats and `Quake` the generic span loop).
+/// Any format through the span loop generic over the format and the strategy (`Rasterizer::draw_generic`; W16's
+/// too, which `Rasterizer::draw` gives to the tiers' own loops: those are the "lean W16 path" rows).
 fn render_case<F: Codec, R: WSpan>(
     case: &Case,
     tris: &[Tri],
@@ -156,7 +156,7 @@ fn render_case<F: Codec, R: WSpan>(
     let t0 = Instant::now();
     let mut written = 0;
     for t in tris {
-        written += r.draw(&mut frame, Some(&mut buf), t).unwrap().written;
+        written += r.draw_generic(&mut frame, &mut buf, t).unwrap().written;
     }
     let ns = t0.elapsed().as_nanos() as f64;
     (frame, bytes.iter().map(|w| w.code()).collect(), written, ns)
