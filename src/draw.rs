@@ -208,3 +208,108 @@ impl<R: WSpan> Rasterizer<R> {
         self.wireframe_any(target, depth.into_depth(), v)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::format::{W16, Z16};
+    use crate::recip::{Fast, Quake};
+    use crate::setup::T_AT_SNAPPED_CALLS;
+    use crate::{DepthBuffer, NoDepth, Rasterizer, RenderState, Vertex};
+    use embedded_graphics_core::pixelcolor::BinaryColor;
+    use embedded_graphics_core::prelude::{DrawTarget, OriginDimensions, Pixel, Size};
+    use std::vec;
+
+    struct Sink;
+    impl OriginDimensions for Sink {
+        fn size(&self) -> Size {
+            Size::new(32, 32)
+        }
+    }
+    impl DrawTarget for Sink {
+        type Color = BinaryColor;
+        type Error = core::convert::Infallible;
+        fn draw_iter<I: IntoIterator<Item = Pixel<BinaryColor>>>(
+            &mut self,
+            _: I,
+        ) -> Result<(), Self::Error> {
+            Ok(())
+        }
+    }
+
+    /// Which loop a draw takes, seen from the fast tier's set-up: only the W16 draw of a per-pixel-reciprocal
+    /// strategy computes the depth-grid values at the snapped vertices (`t_at_snapped`, for a triangle off the snap
+    /// grid), so a W16 buffer given as `&mut` or as `Some` with `Fast` calls it once, and the generic loop
+    /// (`draw_generic`, `Quake` with a W16 buffer, another format, `NoDepth`) never does.
+    #[test]
+    fn the_types_choose_the_loop() {
+        let on = BinaryColor::On;
+        let t = [
+            Vertex::new(1.3, 1.7, 16.0, on),
+            Vertex::new(30.1, 2.9, 20.0, on),
+            Vertex::new(3.7, 29.2, 24.0, on),
+        ];
+        let state = RenderState::new(1.0, 64.0).unwrap();
+        let calls = |f: &mut dyn FnMut()| {
+            T_AT_SNAPPED_CALLS.with(|c| c.borrow_mut().clear());
+            f();
+            T_AT_SNAPPED_CALLS.with(|c| c.borrow().len())
+        };
+        let mut w16 = vec![0u16; 32 * 32];
+        let mut z16 = vec![0u16; 32 * 32];
+        let mut fast = Rasterizer::<Fast>::new(state);
+        let mut quake = Rasterizer::<Quake<8>>::new(state);
+        let mut d = DepthBuffer::new(&mut w16, 32, 32).unwrap();
+        d.clear();
+        assert_eq!(
+            calls(&mut || {
+                fast.draw(&mut Sink, &mut d, &t).unwrap();
+            }),
+            1
+        );
+        d.clear();
+        assert_eq!(
+            calls(&mut || {
+                fast.draw(&mut Sink, Some(&mut d), &t).unwrap();
+            }),
+            1
+        );
+        d.clear();
+        assert_eq!(
+            calls(&mut || {
+                fast.draw_generic(&mut Sink, &mut d, &t).unwrap();
+            }),
+            0
+        );
+        d.clear();
+        assert_eq!(
+            calls(&mut || {
+                quake.draw(&mut Sink, &mut d, &t).unwrap();
+            }),
+            0
+        );
+        let mut z = DepthBuffer::<Z16>::new_format(&mut z16, 32, 32).unwrap();
+        z.clear_for(&state.range);
+        assert_eq!(
+            calls(&mut || {
+                fast.draw(&mut Sink, &mut z, &t).unwrap();
+            }),
+            0
+        );
+        assert_eq!(
+            calls(&mut || {
+                fast.draw(&mut Sink, NoDepth, &t).unwrap();
+            }),
+            0
+        );
+        let none = || None::<&mut DepthBuffer<'_, W16>>;
+        assert_eq!(
+            calls(&mut || {
+                fast.draw(&mut Sink, none(), &t).unwrap();
+            }),
+            0
+        );
+        // The draws wrote: the dispatch is not an early return.
+        assert!(w16.iter().filter(|&&c| c != 0xffff).count() > 300);
+        assert!(z16.iter().filter(|&&c| c != 0xffff).count() > 300);
+    }
+}
