@@ -1,6 +1,7 @@
 //! The draw methods' entry: which loop a primitive takes, chosen by the types of its depth argument (a buffer of any
 //! format, an `Option` of one, or [`NoDepth`]) and of the rasterizer's strategy, at compile time. Above the stages
-//! (`crate::raster`'s set-up and W16 loops, `crate::packed`'s loop generic over the format): they do not import it.
+//! (`crate::setup`, the W16 loops of `crate::raster`, `crate::fast` and `crate::small`, and `crate::packed`'s loop
+//! generic over the format): they do not import it.
 
 use embedded_graphics_core::draw_target::DrawTarget;
 use embedded_graphics_core::pixelcolor::PixelColor;
