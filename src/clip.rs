@@ -316,7 +316,7 @@ impl<R: WSpan> Rasterizer<R> {
     pub fn draw_world<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
         &mut self,
         target: &mut D,
-        depth: B,
+        mut depth: B,
         m: &Mat4,
         vp: &Viewport,
         p: &[[f32; 3]; 3],
@@ -328,7 +328,6 @@ impl<R: WSpan> Rasterizer<R> {
     {
         let (planes, poly) = self.clip_world(m, vp, p)?;
         let mut stats = Stats::default();
-        let mut depth = depth;
         for k in 1..poly.len().saturating_sub(1) {
             let v = fan(&planes, &poly, k, &|_| color);
             stats += depth.draw_triangle(self, target, &v)?;

@@ -121,14 +121,13 @@ impl<R: WSpan> Rasterizer<R> {
     pub fn draw<'b, 'a: 'b, B: IntoDepth<'b, 'a>, D>(
         &mut self,
         target: &mut D,
-        depth: B,
+        mut depth: B,
         v: &[impl VertexInput<Color = D::Color>; 3],
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
         D::Color: PixelColor,
     {
-        let mut depth = depth;
         depth.draw_triangle(self, target, v)
     }
 
@@ -213,29 +212,12 @@ impl<R: WSpan> Rasterizer<R> {
 #[cfg(test)]
 mod tests {
     use crate::format::{W16, Z16};
+    use crate::packed::code_tests::Sink;
     use crate::recip::{Fast, Quake};
     use crate::setup::T_AT_SNAPPED_CALLS;
     use crate::{DepthBuffer, NoDepth, Rasterizer, RenderState, Vertex};
     use embedded_graphics_core::pixelcolor::BinaryColor;
-    use embedded_graphics_core::prelude::{DrawTarget, OriginDimensions, Pixel, Size};
     use std::vec;
-
-    struct Sink;
-    impl OriginDimensions for Sink {
-        fn size(&self) -> Size {
-            Size::new(32, 32)
-        }
-    }
-    impl DrawTarget for Sink {
-        type Color = BinaryColor;
-        type Error = core::convert::Infallible;
-        fn draw_iter<I: IntoIterator<Item = Pixel<BinaryColor>>>(
-            &mut self,
-            _: I,
-        ) -> Result<(), Self::Error> {
-            Ok(())
-        }
-    }
 
     /// Which loop a draw takes, seen from the fast tier's set-up: only the W16 draw of a per-pixel-reciprocal
     /// strategy computes the depth-grid values at the snapped vertices (`t_at_snapped`, for a triangle off the snap

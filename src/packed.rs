@@ -883,7 +883,7 @@ mod zconst_tests {
 }
 
 #[cfg(test)]
-mod code_tests {
+pub(crate) mod code_tests {
     use crate::format::{DepthFormat, Storage, W16F, W32F};
     use crate::raster::Rasterizer;
     use crate::recip::Fast;
@@ -894,7 +894,8 @@ mod code_tests {
     use embedded_graphics_core::prelude::{DrawTarget, OriginDimensions, Pixel, Size};
     use std::vec;
 
-    struct Sink;
+    /// A 32 x 32 target that takes every pixel and keeps none (the draw tests read the depth buffer).
+    pub(crate) struct Sink;
     impl OriginDimensions for Sink {
         fn size(&self) -> Size {
             Size::new(32, 32)

@@ -392,8 +392,8 @@ fn run_planned_tris<F: Codec<Word: bytemuck::Pod>, R: SpanRecip, C: Counter, con
                 hash.words(&buf.data()[row * w..(row + 1) * w]);
             }
         } else {
-            // The format's words in the plan's storage (`u32`-aligned: [`u16_words`]); a 4-byte format's buffer
-            // starts on a 4-byte boundary.
+            // The format's words in the plan's storage (`u32`-aligned: [`u16_words`]), so a 4-byte format's buffer
+            // starts on a 4-byte boundary and the cast's error is not reached.
             let bytes: &mut [u8] = bytemuck::cast_slice_mut(depth);
             let words: &mut [F::Word] = bytemuck::try_cast_slice_mut(&mut bytes[..n * F::BYTES])
                 .map_err(|_| Error::BufferSize {
