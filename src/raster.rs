@@ -43,8 +43,8 @@ use crate::setup::slope_bias;
 #[cfg(test)]
 use crate::setup::FAST_T_USED;
 use crate::setup::{
-    depth_plane, grid_bits, rows_of, t_at_snapped, Geom, Plane, Setup, Stats, TMemo, MIN_FRAC,
-    SUBPIXEL_BITS,
+    depth_plane, grid_bits, rows_of, t_at_snapped, Geom, Plane, Remember, Setup, Solved, Stats,
+    TMemo, MIN_FRAC, SUBPIXEL_BITS,
 };
 use crate::state::{Compare, DepthMode};
 use crate::state::{Cull, RenderState, MAX_T_LOG2};
@@ -150,6 +150,20 @@ impl<R: WSpan> Rasterizer<R> {
         rows: (i32, u16),
         fast: bool,
     ) -> Result<Result<Walk, Stats>, Error> {
+        Ok(self.prepare_memo(s, rows, fast, None)?.map(|(w, _)| w))
+    }
+
+    /// [`Rasterizer::prepare_setup`] with the plane of `T` remembered from an earlier band (`solved`: no depth grid,
+    /// no solve), and the exact solve's plane to remember for the next (`None` where the fast set-up solved it). A
+    /// walk from a remembered plane keeps the snapped vertices' `T` in `t_vertex` (the lean W16 loops, the only
+    /// callers with a memo, do not read it).
+    pub(crate) fn prepare_memo(
+        &self,
+        s: &Setup,
+        rows: (i32, u16),
+        fast: bool,
+        solved: Option<Solved>,
+    ) -> Result<Result<(Walk, Option<Solved>), Stats>, Error> {
         let [p0, p1, p2] = s.p;
         let area = (p1.x - p0.x) as i64 * (p2.y - p0.y) as i64
             - (p2.x - p0.x) as i64 * (p1.y - p0.y) as i64;
@@ -187,13 +201,16 @@ impl<R: WSpan> Rasterizer<R> {
         };
         // The fast set-up solves through the snapped vertices, with the depth-grid plane's `T` there off the grid.
         let at_snapped = match small {
-            true if !s.on_grid => s.fast_t.map(|t| order.map(|k| t[k])),
+            true if !s.on_grid && solved.is_none() => s.fast_t.map(|t| order.map(|k| t[k])),
             _ => None,
         };
         if let Some(tv) = at_snapped {
             t_or = tv;
         }
-        let (dq, darea, dbits, dorigin) = if s.on_grid || at_snapped.is_some() {
+        if let Some(sv) = solved {
+            frac = sv.frac;
+        }
+        let (dq, darea, dbits, dorigin) = if s.on_grid || at_snapped.is_some() || solved.is_some() {
             snapped_plane
         } else {
             let q = order.map(|k| s.q[k]);
@@ -232,14 +249,18 @@ impl<R: WSpan> Rasterizer<R> {
             j_ref: j_first,
             j0,
         };
-        let fast_plane = if small && (s.on_grid || at_snapped.is_some()) {
+        let fast_plane = if small && solved.is_none() && (s.on_grid || at_snapped.is_some()) {
             Plane::solve_fast(t_or, &geom)
         } else {
             None
         };
-        let t = match fast_plane {
-            Some(t) => t,
-            None => Plane::solve(t_or, &geom),
+        let (t, solved) = match (fast_plane, solved) {
+            (Some(t), _) => (t, None),
+            (None, Some(sv)) => (sv.plane.at_row(&geom), Some(sv)),
+            (None, None) => {
+                let plane = Plane::solve_ref(t_or, &geom);
+                (plane.at_row(&geom), Some(Solved { plane, frac }))
+            }
         };
         let edges = if small {
             let (ox, oy) = (xmin >> SUBPIXEL_BITS, ymin >> SUBPIXEL_BITS);
@@ -256,26 +277,44 @@ impl<R: WSpan> Rasterizer<R> {
             ]
         };
         let exact = edges.iter().map(Edge::rows_exact).min().unwrap_or(1 << 24);
-        Ok(Ok(Walk {
-            frac,
-            t_vertex: t_or,
-            edges,
-            j: j0,
-            exact,
-            left: exact,
-            geom,
-            order,
-            j1,
-            t,
-            span: SpanCtx {
-                t_lo: 1u64 << frac,
-                t_hi: self.state.range.t_max(frac),
-                shift_base: 94 - frac,
-                #[cfg(feature = "bias")]
-                bias: bias_of(&self.state, &s.p, &s.t, s.frac),
+        Ok(Ok((
+            Walk {
+                frac,
+                t_vertex: t_or,
+                edges,
+                j: j0,
+                exact,
+                left: exact,
+                geom,
+                order,
+                j1,
+                t,
+                span: SpanCtx {
+                    t_lo: 1u64 << frac,
+                    t_hi: self.state.range.t_max(frac),
+                    shift_base: 94 - frac,
+                    #[cfg(feature = "bias")]
+                    bias: bias_of(&self.state, &s.p, &s.t, s.frac),
+                },
             },
-        }))
+            solved,
+        )))
     }
+}
+
+/// Whether the snapped triangle's box is one the small-triangle path (`crate::small`) may take: under 32 px wide and
+/// 126 px high. Outside it, that path declines whatever the band and the state.
+#[inline(always)]
+fn small_box(p: &[Sub; 3]) -> bool {
+    let (w, h) = box_size(p);
+    w < 32 << SUBPIXEL_BITS && h < 126 << SUBPIXEL_BITS
+}
+
+#[inline(always)]
+fn box_size(p: &[Sub; 3]) -> (i32, i32) {
+    let w = p[0].x.max(p[1].x).max(p[2].x) - p[0].x.min(p[1].x).min(p[2].x);
+    let h = p[0].y.max(p[1].y).max(p[2].y) - p[0].y.min(p[1].y).min(p[2].y);
+    (w, h)
 }
 
 impl<R: SpanRecip> Rasterizer<R> {
@@ -289,10 +328,12 @@ impl<R: SpanRecip> Rasterizer<R> {
         }
     }
 
-    /// What a remembered [`t_at_snapped`] value depends on besides the triangle: the strategy's way to it and the far
-    /// plane (the vertices' `T`).
+    /// What a remembered [`t_at_snapped`] value or plane depends on besides the triangle: the strategy's way to it
+    /// (its seed, and whether it is of the fast tier, whose set-up differs) and the far plane (the vertices' `T`).
     pub(crate) fn memo_tag(&self) -> u64 {
-        ((R::DIV_SEED as u64) << 32) | self.state.range.far().to_bits() as u64
+        ((R::FAST_W16 as u64) << 33)
+            | ((R::DIV_SEED as u64) << 32)
+            | self.state.range.far().to_bits() as u64
     }
 
     /// [`Rasterizer::draw`], with `memo` keeping the fast tier's depth-grid values ([`t_at_snapped`]) across the
@@ -315,21 +356,37 @@ impl<R: SpanRecip> Rasterizer<R> {
         // Only for a triangle with rows in the buffer (a band's draws include triangles that only come near it):
         // one that has none draws nothing either way, and both paths find that before they look at `fast_t`.
         let (first, last) = rows_of(&s.p);
-        if R::FAST_W16
-            && !s.on_grid
-            && first <= depth.y0().saturating_add(depth.height() as i32 - 1)
-            && last >= depth.y0()
-        {
-            s.fast_t = match memo.get() {
-                Some(t) => t,
-                None if R::DIV_SEED => t_at_snapped::<true>(&s),
-                None => t_at_snapped::<false>(&s),
-            };
-            memo.put(s.fast_t, last);
+        let in_buffer =
+            first <= depth.y0().saturating_add(depth.height() as i32 - 1) && last >= depth.y0();
+        // What an earlier band of the frame remembered: the depth-grid values, or the solved plane of a triangle
+        // the small-triangle path never takes (a fact of the triangle, whatever the band or the state: its box, or
+        // an exact-tier strategy).
+        let mut solved = None;
+        if in_buffer {
+            match memo.take() {
+                Some(Remember::Plane(sv)) => solved = Some(sv),
+                Some(Remember::T(t)) => s.fast_t = t,
+                None if R::FAST_W16 && !s.on_grid => {
+                    s.fast_t = if R::DIV_SEED {
+                        t_at_snapped::<true>(&s)
+                    } else {
+                        t_at_snapped::<false>(&s)
+                    }
+                }
+                None => {}
+            }
             #[cfg(test)]
-            FAST_T_USED.with(|c| c.borrow_mut().push((s.p.map(|p| (p.x, p.y)), s.fast_t)));
+            if R::FAST_W16 && !s.on_grid && solved.is_none() {
+                FAST_T_USED.with(|c| c.borrow_mut().push((s.p.map(|p| (p.x, p.y)), s.fast_t)));
+            }
         }
-        if R::FAST_W16 && cmp == Compare::Less && write && !self.state.has_bias() {
+        // A remembered plane: a triangle the small-triangle path declines.
+        if R::FAST_W16
+            && solved.is_none()
+            && cmp == Compare::Less
+            && write
+            && !self.state.has_bias()
+        {
             // The strategy's seed (a constant of `R`: the other branch is not compiled into the firmware).
             let small = if R::DIV_SEED {
                 crate::small::draw::<Divide, D>(target, depth, &s, &self.state, v[0].color())?
@@ -337,13 +394,28 @@ impl<R: SpanRecip> Rasterizer<R> {
                 crate::small::draw::<Chord, D>(target, depth, &s, &self.state, v[0].color())?
             };
             if let Some(stats) = small {
+                if in_buffer && !s.on_grid {
+                    memo.keep(Remember::T(s.fast_t), last);
+                }
                 return Ok(stats);
             }
         }
-        let mut w = match self.prepare_setup(&s, (depth.y0(), depth.height()), R::FAST_W16)? {
-            Ok(w) => w,
-            Err(stats) => return Ok(stats),
-        };
+        let (mut w, solved) =
+            match self.prepare_memo(&s, (depth.y0(), depth.height()), R::FAST_W16, solved)? {
+                Ok(w) => w,
+                Err(stats) => return Ok(stats),
+            };
+        if in_buffer {
+            // The plane of a triangle the small-triangle path never takes (its box: checked only here, off the
+            // small triangles' way); the depth-grid values of the others, where the set-up reads them.
+            match solved {
+                Some(sv) if !R::FAST_W16 || !small_box(&s.p) => {
+                    memo.keep(Remember::Plane(sv), last)
+                }
+                _ if R::FAST_W16 && !s.on_grid => memo.keep(Remember::T(s.fast_t), last),
+                _ => {}
+            }
+        }
         let color = v[0].color();
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {

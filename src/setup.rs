@@ -98,23 +98,41 @@ pub(crate) struct Setup<const N: usize = 3> {
     pub(crate) frac: u32,
 }
 
-/// Where [`crate::Rasterizer::draw_memo`] finds and leaves a triangle's [`t_at_snapped`] values.
+/// A triangle's plane of `T` as the exact solve gives it ([`Plane::solve_ref`]: at the reference row, before
+/// [`Plane::at_row`] moves it to a band's first row) and the fraction bits it was solved with: a function of the
+/// triangle, the far plane and the strategy alone, so a remembered one draws exactly what a computed one does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Solved {
+    pub(crate) plane: Plane,
+    pub(crate) frac: u32,
+}
+
+/// What a memo keeps of a triangle from one band of a frame for the next ([`TMemo`]): the fast tier's depth-grid
+/// values ([`t_at_snapped`]; `None` where declined), or, for a triangle the small-triangle path never takes, its
+/// solved plane.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Remember {
+    T(Option<[i64; 3]>),
+    Plane(Solved),
+}
+
+/// Where [`crate::Rasterizer::draw_memo`] finds and leaves what it remembers of a triangle ([`Remember`]).
 pub trait TMemo {
-    /// The values remembered for this triangle, if any.
-    fn get(&mut self) -> Option<Option<[i64; 3]>>;
+    /// What was remembered for this triangle, if anything (taken: each band keeps it again for the next).
+    fn take(&mut self) -> Option<Remember>;
     /// This triangle's values, and its last row (the memo keeps them only for a triangle that reaches a later band).
-    fn put(&mut self, t: Option<[i64; 3]>, last_row: i32);
+    fn keep(&mut self, r: Remember, last_row: i32);
 }
 
 impl<M: TMemo> TMemo for Option<M> {
     #[inline(always)]
-    fn get(&mut self) -> Option<Option<[i64; 3]>> {
-        self.as_mut().and_then(|m| m.get())
+    fn take(&mut self) -> Option<Remember> {
+        self.as_mut().and_then(|m| m.take())
     }
     #[inline(always)]
-    fn put(&mut self, t: Option<[i64; 3]>, last_row: i32) {
+    fn keep(&mut self, r: Remember, last_row: i32) {
         if let Some(m) = self {
-            m.put(t, last_row);
+            m.keep(r, last_row);
         }
     }
 }
@@ -124,11 +142,11 @@ pub struct NoMemo;
 
 impl TMemo for NoMemo {
     #[inline(always)]
-    fn get(&mut self) -> Option<Option<[i64; 3]>> {
+    fn take(&mut self) -> Option<Remember> {
         None
     }
     #[inline(always)]
-    fn put(&mut self, _: Option<[i64; 3]>, _: i32) {}
+    fn keep(&mut self, _: Remember, _: i32) {}
 }
 
 /// Rows whose pixel centre lies in the snapped vertices' y-range (possibly empty: first > last).
@@ -274,6 +292,10 @@ std::thread_local! {
     /// The snapped vertices of each call of [`t_at_snapped`] on this thread (tests of the mesh's plane cache count
     /// what it saves).
     pub(crate) static T_AT_SNAPPED_CALLS: core::cell::RefCell<std::vec::Vec<[(i32, i32); 3]>> =
+        const { core::cell::RefCell::new(std::vec::Vec::new()) };
+    /// The snapped vertices of each exact plane solve ([`Plane::solve_ref`]) on this thread (tests of the memo count
+    /// what it saves).
+    pub(crate) static PLANE_SOLVES: core::cell::RefCell<std::vec::Vec<[(i32, i32); 3]>> =
         const { core::cell::RefCell::new(std::vec::Vec::new()) };
     /// The snapped vertices and the depth-grid values of each draw that used them (computed or remembered).
     #[allow(clippy::type_complexity)]
@@ -565,7 +587,7 @@ pub(crate) fn mul_96_32(a: i128, b: i32) -> i128 {
 }
 
 /// A quantity linear in screen space: its value at `(i_ref, current row)` and its steps per column and row.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Plane {
     pub(crate) row: i64,
     pub(crate) sx: i64,
@@ -579,6 +601,12 @@ impl Plane {
     /// reference pixel below `2^31` units, by the choice of the grid): `|g| < 2^93`, the numerator below `2^125`,
     /// `area < 2^63`.
     pub(crate) fn solve(v: [i64; 3], g: &Geom) -> Plane {
+        Plane::solve_ref(v, g).at_row(g)
+    }
+    /// [`Plane::solve`] at the reference row `g.j_ref` (what a memo keeps across bands: [`Solved`]).
+    pub(crate) fn solve_ref(v: [i64; 3], g: &Geom) -> Plane {
+        #[cfg(test)]
+        PLANE_SOLVES.with(|c| c.borrow_mut().push(g.p.map(|p| (p.x, p.y))));
         let [p0, p1, p2] = g.dq;
         // |v| < 2^61, so the differences fit i64; the products by 32-bit position differences are exact limb
         // products (`mul_64_32`), where an i128 multiply is a chain of library calls on the 32-bit cores.
@@ -607,11 +635,10 @@ impl Plane {
             sx: dv.div_round(gx << g.dbits) as i64,
             sy: dv.div_round(gy << g.dbits) as i64,
         }
-        .at_row(g)
     }
     /// From the reference row to the first row walked, by whole row steps (what walking there would give).
     #[inline]
-    fn at_row(mut self, g: &Geom) -> Plane {
+    pub(crate) fn at_row(mut self, g: &Geom) -> Plane {
         self.row = self
             .row
             .wrapping_add(self.sy.wrapping_mul((g.j0 - g.j_ref) as i64));

@@ -237,10 +237,103 @@ pub fn run_scene_bounded<R: SpanRecip, C: Counter>(
     depth: &mut [u16],
     bound: &mut [u16],
     counter: &mut C,
+    on_band: impl FnMut(u16, &[u16]),
+) -> Result<Run, Error> {
+    run_scene_cached::<R, C>(scene, color, depth, bound, &mut (), counter, on_band)
+}
+
+impl wraster::mesh::Triangle for Tri {
+    type Vertex = Vertex<Rgb565>;
+    #[inline]
+    fn vertices(&self) -> [Vertex<Rgb565>; 3] {
+        Tri::vertices(self)
+    }
+}
+
+/// How a board's standard-scene run draws its triangles: each on its own (`()`, for a frame in one band: nothing
+/// to remember) or as a list frame with a plane cache ([`SceneCache`]: a triangle reaching several bands is set up
+/// once a frame where the cache has room). A type, not a value: a board links only the draw it uses.
+pub trait SceneFrames {
+    /// The frame of a scene's triangles.
+    type Frame<'a>: DrawTris
+    where
+        Self: 'a;
+    /// The frame of `tris`, for one pass over the bands.
+    fn frame<'a>(&'a mut self, tris: &'a [Tri]) -> Self::Frame<'a>;
+}
+
+/// One triangle of a [`SceneFrames::Frame`] drawn into a band.
+pub trait DrawTris {
+    /// Triangle `k` (`t`) into the band.
+    fn draw<R: SpanRecip>(
+        &self,
+        r: &mut Rasterizer<R>,
+        band: &mut ColorBand<'_, Rgb565>,
+        buf: &mut DepthBuffer<'_>,
+        k: usize,
+        t: &Tri,
+    ) -> Result<Stats, Error>;
+}
+
+impl SceneFrames for () {
+    type Frame<'a> = ();
+    fn frame<'a>(&'a mut self, _: &'a [Tri]) {}
+}
+
+impl DrawTris for () {
+    #[inline(always)]
+    fn draw<R: SpanRecip>(
+        &self,
+        r: &mut Rasterizer<R>,
+        band: &mut ColorBand<'_, Rgb565>,
+        buf: &mut DepthBuffer<'_>,
+        _: usize,
+        t: &Tri,
+    ) -> Result<Stats, Error> {
+        r.draw(band, buf, &t.vertices())
+    }
+}
+
+impl<const N: usize> SceneFrames for wraster::mesh::PlaneCache<N> {
+    type Frame<'a> = wraster::mesh::ListFrame<'a, Tri>;
+    fn frame<'a>(&'a mut self, tris: &'a [Tri]) -> Self::Frame<'a> {
+        self.list(tris)
+    }
+}
+
+impl DrawTris for wraster::mesh::ListFrame<'_, Tri> {
+    #[inline(always)]
+    fn draw<R: SpanRecip>(
+        &self,
+        r: &mut Rasterizer<R>,
+        band: &mut ColorBand<'_, Rgb565>,
+        buf: &mut DepthBuffer<'_>,
+        k: usize,
+        _: &Tri,
+    ) -> Result<Stats, Error> {
+        r.draw_listed(band, buf, self, k)
+    }
+}
+
+/// Triangles a board's standard-scene plane cache holds ([`SceneCache`]): every triangle of W1 and W2 that reaches
+/// the next band, and some of the terrain's and W3's (the small triangles' depth-grid values, where off the grid).
+pub const SCENE_CACHE: usize = 64;
+/// A board's standard-scene plane cache (for scenes drawn in more than one band).
+pub type SceneCache = wraster::mesh::PlaneCache<SCENE_CACHE>;
+
+/// [`run_scene_bounded`], the triangles drawn as `cache` says ([`SceneFrames`]).
+pub fn run_scene_cached<R: SpanRecip, C: Counter>(
+    scene: &SceneData,
+    color: &mut [u16],
+    depth: &mut [u16],
+    bound: &mut [u16],
+    cache: &mut impl SceneFrames,
+    counter: &mut C,
     mut on_band: impl FnMut(u16, &[u16]),
 ) -> Result<Run, Error> {
     let band_h = (depth.len() / WIDTH as usize) as u16;
     let mut r = Rasterizer::<R>::new(RenderState::new(scene.near, scene.far)?);
+    let frame = cache.frame(scene.tris);
     let mut stats = Stats::default();
     let (mut instructions, mut hash, mut bands) = (0u64, Fnv::default(), 0u32);
     let mut y0 = 0u16;
@@ -255,9 +348,9 @@ pub fn run_scene_bounded<R: SpanRecip, C: Counter>(
         let mut band = ColorBand::<Rgb565>::band(color, WIDTH, y0 as i32, h)?;
         let (b0, b1) = (y0 as i32, (y0 + h) as i32 - 1);
         counter.start();
-        for t in scene.tris {
+        for (k, t) in scene.tris.iter().enumerate() {
             if t.rows.0 <= b1 && t.rows.1 >= b0 {
-                stats += r.draw(&mut band, &mut buf, &t.vertices())?;
+                stats += frame.draw(&mut r, &mut band, &mut buf, k, t)?;
             }
         }
         instructions += counter.stop();
@@ -634,6 +727,21 @@ pub fn run_all_bounded<R: SpanRecip, C: Counter>(
     depth: &mut [u16],
     bound: &mut [u16],
     counter: &mut C,
+    print: impl FnMut(core::fmt::Arguments<'_>),
+) -> bool {
+    run_all_cached::<R, C>(board, core, color, depth, bound, &mut (), counter, print)
+}
+
+/// [`run_all_bounded`], the triangles drawn as `cache` says ([`run_scene_cached`]).
+#[allow(clippy::too_many_arguments)]
+pub fn run_all_cached<R: SpanRecip, C: Counter>(
+    board: &str,
+    core: &str,
+    color: &mut [u16],
+    depth: &mut [u16],
+    bound: &mut [u16],
+    cache: &mut impl SceneFrames,
+    counter: &mut C,
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
     let mut ok = true;
@@ -641,7 +749,15 @@ pub fn run_all_bounded<R: SpanRecip, C: Counter>(
         .iter()
         .filter(|s| option_env!("ONLY").is_none_or(|o| o == s.name))
     {
-        match run_scene_bounded::<R, C>(scene, color, depth, &mut *bound, counter, |_, _| {}) {
+        match run_scene_cached::<R, C>(
+            scene,
+            color,
+            depth,
+            &mut *bound,
+            &mut *cache,
+            counter,
+            |_, _| {},
+        ) {
             Ok(run) => print(format_args!("{}", bench_line(board, core, &run))),
             Err(e) => {
                 print(format_args!("error board={board} scene={} {e}", scene.name));

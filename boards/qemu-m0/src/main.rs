@@ -25,9 +25,9 @@ use wraster::recip::SpanRecip;
 #[cfg(not(any(feature = "size-probe", feature = "plan")))]
 use wraster::recip::{Exact, FastDiv, PrevPixel};
 #[cfg(not(feature = "torus"))]
-use wraster_board::run_all;
+use wraster_board::{run_all_cached, SceneCache};
 #[cfg(not(any(feature = "size-probe", feature = "torus")))]
-use wraster_board::{run_scene, SCENES};
+use wraster_board::{run_scene_cached, SCENES};
 use wraster_board::{SysTick, HEIGHT, WIDTH};
 #[cfg(feature = "torus")]
 use {
@@ -45,21 +45,53 @@ const PIXELS: usize = WIDTH as usize * BAND_ROWS;
 const _: () = assert!((HEIGHT as usize).is_multiple_of(BAND_ROWS));
 
 #[cfg(not(feature = "torus"))]
-fn all<R: SpanRecip>(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
-    run_all::<R, _>("qemu-m0", "m0", color, depth, counter, |line| {
-        hprintln!("{}", line)
-    })
+fn all<R: SpanRecip>(
+    color: &mut [u16],
+    depth: &mut [u16],
+    cache: &mut SceneCache,
+    counter: &mut SysTick,
+) -> bool {
+    run_all_cached::<R, _>(
+        "qemu-m0",
+        "m0",
+        color,
+        depth,
+        &mut [],
+        cache,
+        counter,
+        |line| hprintln!("{}", line),
+    )
 }
 
 /// The cost of banding, measured on this core: every scene drawn again in 60 bands of 4 rows; the extra
 /// instructions over the 30-band run, divided by the 30 extra bands, are what one band costs (triangle setup
 /// repeated for triangles spanning both halves, the span walk restarted, the binning test).
 #[cfg(not(any(feature = "size-probe", feature = "torus")))]
-fn band_overhead(color: &mut [u16], depth: &mut [u16], counter: &mut SysTick) -> bool {
+fn band_overhead(
+    color: &mut [u16],
+    depth: &mut [u16],
+    cache: &mut SceneCache,
+    counter: &mut SysTick,
+) -> bool {
     let half = WIDTH as usize * BAND_ROWS / 2;
+    fn run(
+        scene: &wraster_board::SceneData,
+        color: &mut [u16],
+        depth: &mut [u16],
+        cache: &mut SceneCache,
+        counter: &mut SysTick,
+    ) -> Result<wraster_board::Run, wraster::Error> {
+        run_scene_cached::<Fast, _>(scene, color, depth, &mut [], cache, counter, |_, _| {})
+    }
     for scene in &SCENES {
-        let r30 = run_scene::<Fast, _>(scene, color, depth, counter);
-        let r60 = run_scene::<Fast, _>(scene, &mut color[..half], &mut depth[..half], counter);
+        let r30 = run(scene, color, depth, cache, counter);
+        let r60 = run(
+            scene,
+            &mut color[..half],
+            &mut depth[..half],
+            cache,
+            counter,
+        );
         match (r30, r60) {
             (Ok(a), Ok(b)) if a.hash == b.hash => hprintln!(
                 "band-overhead board=qemu-m0 scene={} bands={}/{} instructions={}/{} instr_per_extra_band={}",
@@ -160,13 +192,16 @@ fn main() -> ! {
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
+    // The plane cache of the standard scenes (`wraster::mesh::PlaneCache`, `wraster_board::SCENE_CACHE`
+    // triangles): a triangle reaching several bands is set up once a frame where it has room.
+    static mut CACHE: SceneCache = SceneCache::new();
     // The coarse bound of `--features coarse`: one code per 8 pixels of each band row (640 bytes).
     #[cfg(feature = "coarse")]
     static mut BOUND: [u16; wraster::bound_len(WIDTH as usize, BAND_ROWS)] =
         [0; wraster::bound_len(WIDTH as usize, BAND_ROWS)];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
-    let ok = all::<Fast>(COLOR, DEPTH, &mut counter);
+    let ok = all::<Fast>(COLOR, DEPTH, CACHE, &mut counter);
     // `--features coarse`: the default again with a coarse depth bound (`bound=coarse` lines), same hashes.
     #[cfg(feature = "coarse")]
     let ok = ok
@@ -184,10 +219,10 @@ fn main() -> ! {
     // The other strategies for the hash test (`FastDiv`, the M4's and RV32's default: its division is a library
     // call on this core, which has no divide instruction).
     let ok = ok
-        & all::<FastDiv>(COLOR, DEPTH, &mut counter)
-        & all::<Exact>(COLOR, DEPTH, &mut counter)
-        & all::<PrevPixel>(COLOR, DEPTH, &mut counter)
-        & band_overhead(COLOR, DEPTH, &mut counter);
+        & all::<FastDiv>(COLOR, DEPTH, CACHE, &mut counter)
+        & all::<Exact>(COLOR, DEPTH, CACHE, &mut counter)
+        & all::<PrevPixel>(COLOR, DEPTH, CACHE, &mut counter)
+        & band_overhead(COLOR, DEPTH, CACHE, &mut counter);
     debug::exit(if ok {
         debug::EXIT_SUCCESS
     } else {

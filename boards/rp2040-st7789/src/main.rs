@@ -24,7 +24,7 @@ use rp2040_hal::{entry, pac, Sio, Spi, Timer, Watchdog};
 use wraster::mesh::Projected;
 use wraster::recip::Fast;
 use wraster::scenes::torus::{TRIANGLES, VERTICES};
-use wraster_board::{run_scene_with, run_torus_with, NoCounter, SCENES, WIDTH};
+use wraster_board::{run_scene_cached, run_torus_with, NoCounter, SCENES, WIDTH};
 
 /// The second-stage boot loader for the Pico's W25Q080 flash.
 #[link_section = ".boot2"]
@@ -96,7 +96,17 @@ fn main() -> ! {
         });
         let _ = display.set_pixels(0, y0, SIDE - 1, y0 + rows as u16 - 1, pixels);
     };
-    let _ = run_scene_with::<Fast, _>(terrain, &mut color, &mut depth, &mut NoCounter, &mut push);
+    // The terrain in bands with the standard scenes' plane cache: a triangle reaching several bands is set up once.
+    let mut scene_cache = wraster_board::SceneCache::new();
+    let _ = run_scene_cached::<Fast, _>(
+        terrain,
+        &mut color,
+        &mut depth,
+        &mut [],
+        &mut scene_cache,
+        &mut NoCounter,
+        &mut push,
+    );
     let mut verts = [Projected::default(); VERTICES];
     // Row bins for the 15 bands (`Rasterizer::bin_mesh`): each band sets up only the triangles that can reach it.
     let mut bins = [0u8; TRIANGLES];
