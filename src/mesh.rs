@@ -148,8 +148,10 @@ struct Bins<'a> {
 /// that set-up for vertices off the 1/256 px grid is the depth-grid correction (the plane through the vertices as
 /// given, evaluated at the snapped ones: about 1,690 instructions a triangle on the Cortex-M0, a fifth of W4's
 /// frame there). The cache keeps those values for the triangles that reach the next band, so each is computed
-/// once a frame. It is a function of the triangle alone, so the frames are the same with and without the cache;
-/// a full cache just computes the values again. Bands must come in order, top to bottom, for it to help: a band that
+/// once a frame; for a triangle too large for the small-triangle path it keeps the solved plane of `T` instead (the
+/// exact solve, three 128-bit divisions). Both are functions of the triangle alone, so the frames are the same with
+/// and without the cache; a full cache just computes the values again. Triangle lists use it too
+/// ([`PlaneCache::list`]). Bands must come in order, top to bottom, for it to help: a band that
 /// does not start where the previous one ended, a change of the far plane or of the strategy empties it.
 ///
 /// A frame in bands of 8 rows, transformed once, binned by rows and cached (all in caller storage):
@@ -1084,7 +1086,7 @@ impl<R: SpanRecip> Rasterizer<R> {
 
     /// Draws triangle `k` of `frame` into a W16 buffer: the same pixels, codes and statistics as
     /// [`Rasterizer::draw`] of its vertices, with what [`PlaneCache::list`] describes remembered from the previous
-    /// band for the next. A band begins with the first draw whose buffer has other rows than the last one's; the
+    /// band for the next. A band begins with the first draw whose buffer ends at another row than the last one's; the
     /// cache helps where the bands come top to bottom and, within a band, the triangles in increasing `k` (any other
     /// order draws the same, computing more). `k` beyond the list: [`Error::IndexOutOfRange`].
     pub fn draw_listed<D, T>(
@@ -1116,8 +1118,7 @@ impl<R: SpanRecip> Rasterizer<R> {
     }
 
     /// [`Rasterizer::draw_memo`] of `t` out of line: one copy, outside the caller's loop, which reads the vertices
-    /// itself (measured on the Cortex-M0's W3: 0.4% fewer instructions than inline, 0.5% fewer than the whole of
-    /// `draw_listed` out of line).
+    /// itself (measured on the Cortex-M0's W3: 1.9% fewer instructions than inline).
     #[inline(never)]
     fn draw_remembered<D, T>(
         &mut self,

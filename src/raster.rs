@@ -336,49 +336,63 @@ impl<R: SpanRecip> Rasterizer<R> {
             | self.state.range.far().to_bits() as u64
     }
 
+    /// The fast tier's depth-grid values of `s` ([`t_at_snapped`], the strategy's way).
+    #[inline(always)]
+    fn fast_t(&self, s: &Setup) -> Option<[i64; 3]> {
+        if R::DIV_SEED {
+            t_at_snapped::<true>(s)
+        } else {
+            t_at_snapped::<false>(s)
+        }
+    }
+
     /// [`Rasterizer::draw`], with `memo` keeping the fast tier's depth-grid values ([`t_at_snapped`]) across the
     /// bands of a frame (the mesh's [`crate::mesh::PlaneCache`]); the values are a function of the triangle alone, so
     /// a remembered one draws exactly what a computed one does.
-    pub(crate) fn draw_memo<D>(
+    pub(crate) fn draw_memo<D, M>(
         &mut self,
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
         v: &[impl VertexInput<Color = D::Color>; 3],
-        memo: &mut impl TMemo,
+        memo: &mut M,
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
         D::Color: PixelColor,
+        M: TMemo,
     {
         let (cmp, write) = self.w16_test()?;
         depth.note_compare(cmp, write);
         let mut s = self.setup(v)?;
         // Only for a triangle with rows in the buffer (a band's draws include triangles that only come near it):
         // one that has none draws nothing either way, and both paths find that before they look at `fast_t`.
-        let (first, last) = rows_of(&s.p);
-        let in_buffer =
-            first <= depth.y0().saturating_add(depth.height() as i32 - 1) && last >= depth.y0();
-        // What an earlier band of the frame remembered: the depth-grid values, or the solved plane of a triangle
-        // the small-triangle path never takes (a fact of the triangle, whatever the band or the state: its box, or
-        // an exact-tier strategy).
+        let in_buffer = || {
+            let (first, last) = rows_of(&s.p);
+            (first <= depth.y0().saturating_add(depth.height() as i32 - 1) && last >= depth.y0())
+                .then_some(last)
+        };
+        // Without a memo (`M::KEEPS` false, a constant: the branches below are not compiled) the values where a
+        // path reads them, as ever. With one, what an earlier band of the frame remembered: the depth-grid values,
+        // or the solved plane of a triangle the small-triangle path never takes (a fact of the triangle, whatever
+        // the band or the state: its box, or an exact-tier strategy).
         let mut solved = None;
-        if in_buffer {
-            match memo.take() {
-                Some(Remember::Plane(sv)) => solved = Some(sv),
-                Some(Remember::T(t)) => s.fast_t = t,
-                None if R::FAST_W16 && !s.on_grid => {
-                    s.fast_t = if R::DIV_SEED {
-                        t_at_snapped::<true>(&s)
-                    } else {
-                        t_at_snapped::<false>(&s)
-                    }
+        let mut kept_row = None;
+        if M::KEEPS {
+            if let Some(last) = in_buffer() {
+                kept_row = Some(last);
+                match memo.take() {
+                    Some(Remember::Plane(sv)) => solved = Some(sv),
+                    Some(Remember::T(t)) => s.fast_t = t,
+                    None if R::FAST_W16 && !s.on_grid => s.fast_t = self.fast_t(&s),
+                    None => {}
                 }
-                None => {}
             }
-            #[cfg(test)]
-            if R::FAST_W16 && !s.on_grid && solved.is_none() {
-                FAST_T_USED.with(|c| c.borrow_mut().push((s.p.map(|p| (p.x, p.y)), s.fast_t)));
-            }
+        } else if R::FAST_W16 && !s.on_grid && in_buffer().is_some() {
+            s.fast_t = self.fast_t(&s);
+        }
+        #[cfg(test)]
+        if R::FAST_W16 && !s.on_grid && solved.is_none() && in_buffer().is_some() {
+            FAST_T_USED.with(|c| c.borrow_mut().push((s.p.map(|p| (p.x, p.y)), s.fast_t)));
         }
         // A remembered plane: a triangle the small-triangle path declines.
         if R::FAST_W16
@@ -394,7 +408,7 @@ impl<R: SpanRecip> Rasterizer<R> {
                 crate::small::draw::<Chord, D>(target, depth, &s, &self.state, v[0].color())?
             };
             if let Some(stats) = small {
-                if in_buffer && !s.on_grid {
+                if let (true, Some(last)) = (M::KEEPS && !s.on_grid, kept_row) {
                     memo.keep(Remember::T(s.fast_t), last);
                 }
                 return Ok(stats);
@@ -405,7 +419,7 @@ impl<R: SpanRecip> Rasterizer<R> {
                 Ok(w) => w,
                 Err(stats) => return Ok(stats),
             };
-        if in_buffer {
+        if let (true, Some(last)) = (M::KEEPS, kept_row) {
             // The plane of a triangle the small-triangle path never takes (its box: checked only here, off the
             // small triangles' way); the depth-grid values of the others, where the set-up reads them.
             match solved {

@@ -118,6 +118,8 @@ pub enum Remember {
 
 /// Where [`crate::Rasterizer::draw_memo`] finds and leaves what it remembers of a triangle ([`Remember`]).
 pub trait TMemo {
+    /// Whether this memo keeps anything ([`NoMemo`] does not: its draws compile to the code without a memo).
+    const KEEPS: bool = true;
     /// What was remembered for this triangle, if anything (taken: each band keeps it again for the next).
     fn take(&mut self) -> Option<Remember>;
     /// This triangle's values, and its last row (the memo keeps them only for a triangle that reaches a later band).
@@ -141,6 +143,7 @@ impl<M: TMemo> TMemo for Option<M> {
 pub struct NoMemo;
 
 impl TMemo for NoMemo {
+    const KEEPS: bool = false;
     #[inline(always)]
     fn take(&mut self) -> Option<Remember> {
         None

@@ -235,6 +235,56 @@ fn raster_with<R: SpanRecip>(b: &mut Bytes) {
     assert!(canvas.same_picture(&canvas2), "bands drew another picture");
     assert!(depth.data() == depth2.data(), "bands stored other codes");
 
+    // The flat triangles as a list frame with a plane cache, band by band (`PlaneCache::list`, `draw_listed`): the
+    // same results, pictures and codes as `draw` of each in the same bands and order, with a cache of any size.
+    let flat: Vec<[Vertex<Rgb565>; 3]> = ops.iter().filter(|(g, _)| !g).map(|(_, t)| *t).collect();
+    let (mut few, mut many) = (PlaneCache::<1>::new(), PlaneCache::<8>::new());
+    let lists = [few.list(&flat), many.list(&flat)];
+    let mut plain = (
+        Canvas::new(w as u32, h as u32),
+        Guarded::new(n, 0u16, 0x5a5a),
+    );
+    let mut listed: Vec<_> = lists
+        .iter()
+        .map(|_| {
+            (
+                Canvas::new(w as u32, h as u32),
+                Guarded::new(n, 0u16, 0x5a5a),
+            )
+        })
+        .collect();
+    for y0 in (0..h).step_by(band as usize) {
+        let hh = band.min(h - y0);
+        let span = y0 as usize * w as usize..(y0 + hh) as usize * w as usize;
+        let mut pd =
+            DepthBuffer::band(&mut plain.1.inner()[span.clone()], w, y0 as i32, hh).unwrap();
+        pd.clear();
+        let mut bufs: Vec<_> = listed
+            .iter_mut()
+            .map(|(c, d)| {
+                let mut buf =
+                    DepthBuffer::band(&mut d.inner()[span.clone()], w, y0 as i32, hh).unwrap();
+                buf.clear();
+                (c, buf)
+            })
+            .collect();
+        for (k, t) in flat.iter().enumerate() {
+            let want = r.draw(&mut plain.0, &mut pd, t);
+            for ((c, buf), list) in bufs.iter_mut().zip(&lists) {
+                same_result(&want, r.draw_listed(*c, buf, list, k));
+            }
+        }
+    }
+    plain.1.check();
+    for (c, d) in &listed {
+        d.check();
+        assert!(plain.0.same_picture(c), "a list frame drew another picture");
+        assert!(
+            plain.1.data() == d.data(),
+            "a list frame stored other codes"
+        );
+    }
+
     // A coarse bound kept across the calls (whole frame): the same results, pictures and codes as without it, and
     // no write outside the bound's own buffer.
     let mut canvas4 = Canvas::new(w as u32, h as u32);
