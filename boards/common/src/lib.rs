@@ -316,7 +316,7 @@ impl DrawTris for wraster::mesh::ListFrame<'_, Tri> {
 }
 
 /// Triangles a board's standard-scene plane cache holds ([`SceneCache`]): every triangle of W1 and W2 that reaches
-/// the next band, and some of the terrain's and W3's (the small triangles' depth-grid values, where off the grid).
+/// the next band, and some of the terrain's (its small triangles' depth-grid values, off the grid; W3's lie on it).
 pub const SCENE_CACHE: usize = 64;
 /// A board's standard-scene plane cache (for scenes drawn in more than one band).
 pub type SceneCache = wraster::mesh::PlaneCache<SCENE_CACHE>;
