@@ -494,7 +494,7 @@ impl Walk {
                     if lo >= hi {
                         break 'row;
                     }
-                    let mut v = sr.wrapping_add(mul_small(sx, (lo - ox) as u32));
+                    let v = sr.wrapping_add(mul_small(sx, (lo - ox) as u32));
                     let row = if ROWS_BY_DIVISION {
                         match depth
                             .data_mut()
@@ -506,26 +506,7 @@ impl Walk {
                     } else {
                         &mut depth.row_mut(j)[lo as usize..hi as usize]
                     };
-                    // Bit `n - 1 - i` for the run's pixel `i`.
-                    let mut pass = 0u32;
-                    for stored in row.iter_mut() {
-                        let h = (v >> 32) as u32;
-                        let (m, sc) = if SAME_LZ {
-                            (h, sc0)
-                        } else {
-                            let lz = lz_small(h);
-                            ((h << lz) | ((v as u32) >> (32 - lz)), s0 - lz - 1)
-                        };
-                        let hi = mul_hi(kn, fresh61::<S>(m) as u32);
-                        // Below 2^16 (the module doc), compared as u32.
-                        let c = ((hi >> sc) + 1) >> 1;
-                        let ok = c < *stored as u32;
-                        pass = (pass << 1) | u32::from(ok);
-                        if ok {
-                            *stored = c as u16;
-                        }
-                        v = v.wrapping_add(sx);
-                    }
+                    let pass = depth_run::<S, SAME_LZ>(row, v, sx, kn, s0, sc0);
                     let n = (hi - lo) as u32; // at most 32: the box is under 32 px wide
                     stats.fragments += n;
                     stats.written += emit(target, lo, j, n, pass, color)?;
@@ -552,6 +533,50 @@ impl Walk {
         }
         Ok(stats)
     }
+}
+
+/// One run's depth loop: each pixel's code from `S` (`v` at the run's first pixel, `sx` a column), tested against
+/// the stored code and written where less. Bit `n - 1 - i` of the result for the run's pixel `i` that passed. Out of
+/// line on the Cortex-M4, where inlined into the row walk its values did not fit the registers (three reloads from
+/// the stack per pixel); walked by `split_first_mut`, whose loop LLVM sets up for fewer instructions than the slice
+/// iterator's. Measured on the M4: 1.9% fewer instructions on W4 and 1.2% on W3 than inline with the iterator.
+/// Inlined on the M0 and RV32, where the call measured 1.3% to 2.1% more (the walk by `split_first_mut` is within
+/// 0.5% of the iterator's there, either way).
+#[cfg_attr(all(target_arch = "arm", target_has_atomic = "32"), inline(never))]
+#[cfg_attr(
+    not(all(target_arch = "arm", target_has_atomic = "32")),
+    inline(always)
+)]
+fn depth_run<S: FreshSeed, const SAME_LZ: bool>(
+    row: &mut [u16],
+    mut v: u64,
+    sx: u64,
+    kn: u32,
+    s0: u32,
+    sc0: u32,
+) -> u32 {
+    let mut pass = 0u32;
+    let mut row = row;
+    while let Some((stored, rest)) = row.split_first_mut() {
+        row = rest;
+        let h = (v >> 32) as u32;
+        let (m, sc) = if SAME_LZ {
+            (h, sc0)
+        } else {
+            let lz = lz_small(h);
+            ((h << lz) | ((v as u32) >> (32 - lz)), s0 - lz - 1)
+        };
+        let hi = mul_hi(kn, fresh61::<S>(m) as u32);
+        // Below 2^16 (the module doc), compared as u32.
+        let c = ((hi >> sc) + 1) >> 1;
+        let ok = c < *stored as u32;
+        pass = (pass << 1) | u32::from(ok);
+        if ok {
+            *stored = c as u16;
+        }
+        v = v.wrapping_add(sx);
+    }
+    pass
 }
 
 /// `S` at the origin and its steps (`sum_k E_k w_k` over the edge functions `er` at the origin and their steps `ex`,
