@@ -748,9 +748,10 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
 }
 
 /// The first triangle from `k` on whose byte in `of` is a bucket in `[lo, lo + span]` (mod 256) or [`CLIP`]; `of.len()`
-/// when none. Without triangles to clip (`clips` false), four bytes a step: the least of their distances from `lo`
-/// (each bucket is tested once a band, and most are out of reach: on the M0's 60 bands of W4 the byte a step was 5%
-/// of the frame).
+/// when none: one compare a byte, and the [`CLIP`] test only where the binning marked a triangle to clip (`clips`).
+/// Every band tests every byte, and most are out of reach: on the M0's 60 bands of W4 this scan is about 4% of the
+/// frame's instructions (measured: 3.6 million over the 8 frames of 89.7 million). Fewer would take a coarser index
+/// (a bucket range per group of triangles) or the triangles sorted by bucket (two bytes each).
 #[inline]
 fn next_in_reach(of: &[u8], mut k: usize, lo: u8, span: u8, clips: bool) -> usize {
     if !clips {

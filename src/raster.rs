@@ -73,8 +73,20 @@ impl<R: WSpan> Rasterizer<R> {
         }
     }
 
-    /// Snaps and checks `N` vertices and gives their `T` with a common fraction count.
+    /// Snaps and checks `N` vertices and gives their `T` with a common fraction count, and, for a triangle off the
+    /// snap grid, its vertices on the depth grid ([`Rasterizer::depth_grid`]).
     pub(crate) fn setup<V: VertexInput, const N: usize>(
+        &self,
+        v: &[V; N],
+    ) -> Result<Setup<N>, Error> {
+        let mut s = self.setup_snapped(v)?;
+        Self::depth_grid(&mut s, v);
+        Ok(s)
+    }
+
+    /// [`Rasterizer::setup`] without the depth grid (`q` left at the origin): for a draw that may not need it (a
+    /// band whose memo holds the triangle's values; [`Rasterizer::depth_grid`] fills it where it does).
+    pub(crate) fn setup_snapped<V: VertexInput, const N: usize>(
         &self,
         v: &[V; N],
     ) -> Result<Setup<N>, Error> {
@@ -98,35 +110,39 @@ impl<R: WSpan> Rasterizer<R> {
             int_bits = int_bits.max(b);
             tm[k] = (pm, pe);
         }
-        let mut q = [Sub { x: 0, y: 0 }; N];
-        let (mut dbits, mut dorigin) = (SUBPIXEL_BITS, (0, 0));
-        if N == 3 && !on_grid {
-            let (ox, oy) = (
-                p.iter().map(|s| s.x).min().unwrap_or(0) >> SUBPIXEL_BITS,
-                p.iter().map(|s| s.y).min().unwrap_or(0) >> SUBPIXEL_BITS,
-            );
-            let xe = (p.iter().map(|s| s.x).max().unwrap_or(0) >> SUBPIXEL_BITS) - ox;
-            let ye = (p.iter().map(|s| s.y).max().unwrap_or(0) >> SUBPIXEL_BITS) - oy;
-            dbits = grid_bits(xe.max(ye));
-            dorigin = (ox, oy);
-            for k in 0..N {
-                let (x, y) = v[k].depth_xy(dbits, ox, oy);
-                q[k] = Sub { x, y };
-            }
-        }
         // F = 61 - bits(floor(t_max)), t_max < 2^30.
         let frac = (61 - int_bits) as u32;
         let t = tm.map(|(m, e)| round_shift(m, e + frac as i32) as i64);
         Ok(Setup {
             p,
             on_grid,
-            q,
-            dbits,
-            dorigin,
+            q: [Sub { x: 0, y: 0 }; N],
+            dbits: SUBPIXEL_BITS,
+            dorigin: (0, 0),
             fast_t: None,
             t,
             frac,
         })
+    }
+
+    /// A triangle's vertices `v` (snapped and checked as `s`) on the depth grid, where it is off the snap grid: `q`,
+    /// `dbits` and `dorigin` of [`Setup`].
+    pub(crate) fn depth_grid<V: VertexInput, const N: usize>(s: &mut Setup<N>, v: &[V; N]) {
+        if N == 3 && !s.on_grid {
+            let p = &s.p;
+            let (ox, oy) = (
+                p.iter().map(|s| s.x).min().unwrap_or(0) >> SUBPIXEL_BITS,
+                p.iter().map(|s| s.y).min().unwrap_or(0) >> SUBPIXEL_BITS,
+            );
+            let xe = (p.iter().map(|s| s.x).max().unwrap_or(0) >> SUBPIXEL_BITS) - ox;
+            let ye = (p.iter().map(|s| s.y).max().unwrap_or(0) >> SUBPIXEL_BITS) - oy;
+            s.dbits = grid_bits(xe.max(ye));
+            s.dorigin = (ox, oy);
+            for (q, vk) in s.q.iter_mut().zip(v) {
+                let (x, y) = vk.depth_xy(s.dbits, ox, oy);
+                *q = Sub { x, y };
+            }
+        }
     }
 
     /// Snaps, checks, culls and clips a triangle to the buffer's rows, and solves its `t` plane.
@@ -363,13 +379,22 @@ impl<R: SpanRecip> Rasterizer<R> {
     {
         let (cmp, write) = self.w16_test()?;
         depth.note_compare(cmp, write);
-        let mut s = self.setup(v)?;
+        // With a memo, the depth grid only where what it remembered does not stand in for it (below).
+        let mut s = if M::KEEPS {
+            self.setup_snapped(v)?
+        } else {
+            self.setup(v)?
+        };
         // Only for a triangle with rows in the buffer (a band's draws include triangles that only come near it):
         // one that has none draws nothing either way, and both paths find that before they look at `fast_t`.
-        let in_buffer = || {
-            let (first, last) = rows_of(&s.p);
-            (first <= depth.y0().saturating_add(depth.height() as i32 - 1) && last >= depth.y0())
-                .then_some(last)
+        let (p, y0, y_last) = (
+            s.p,
+            depth.y0(),
+            depth.y0().saturating_add(depth.height() as i32 - 1),
+        );
+        let in_buffer = move || {
+            let (first, last) = rows_of(&p);
+            (first <= y_last && last >= y0).then_some(last)
         };
         // Without a memo (`M::KEEPS` false, a constant: the branches below are not compiled) the values where a
         // path reads them, as ever. With one, what an earlier band of the frame remembered: the depth-grid values,
@@ -382,9 +407,15 @@ impl<R: SpanRecip> Rasterizer<R> {
                 kept_row = Some(last);
                 match memo.take() {
                     Some(Remember::Plane(sv)) => solved = Some(sv),
-                    Some(Remember::T(t)) => s.fast_t = t,
-                    None if R::FAST_W16 && !s.on_grid => s.fast_t = self.fast_t(&s),
-                    None => {}
+                    Some(Remember::T(Some(t))) => s.fast_t = Some(t),
+                    // Declined there (a steep plane): the general set-up solves it from the depth grid.
+                    Some(Remember::T(None)) => Self::depth_grid(&mut s, v),
+                    None => {
+                        Self::depth_grid(&mut s, v);
+                        if R::FAST_W16 && !s.on_grid {
+                            s.fast_t = self.fast_t(&s);
+                        }
+                    }
                 }
             }
         } else if R::FAST_W16 && !s.on_grid && in_buffer().is_some() {
