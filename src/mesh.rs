@@ -83,6 +83,7 @@ use crate::clip::{check_matrix, fan, to_clip, Planes, Viewport};
 use crate::projection::Mat4;
 use crate::recip::{SpanRecip, WSpan};
 use crate::setup::{Plane, Remember, Solved};
+use crate::small::Kept;
 use crate::transform::IntTransform;
 use crate::{Cull, DepthBuffer, Error, Rasterizer, Stats, Vertex, VertexInput};
 use core::cell::Cell;
@@ -409,9 +410,10 @@ mod sealed {
     }
 }
 
-/// A remembered triangle: its key (the triangle's index in bits 0 to 23, what is kept in the bits above: [`DECLINED`],
-/// [`PLANE`] and the plane's fraction bits) and its values, each `i64` as two `u32` halves (so a slot is aligned to 4
-/// bytes and takes 28, not 32): the depth-grid values, or the plane's reference value and steps.
+/// A remembered triangle: its key (the triangle's index in bits 0 to 19, what is kept in the bits above: [`DECLINED`],
+/// [`PLANE`], [`SMALL`], the plane's fraction bits or the small triangle's shifts) and its values, each `i64` as two
+/// `u32` halves (so a slot is aligned to 4 bytes and takes 28, not 32): the depth-grid values, the plane's reference
+/// value and steps, or the small triangle's `S` and steps.
 #[derive(Clone, Copy, Debug)]
 struct Slot {
     key: u32,
@@ -419,11 +421,16 @@ struct Slot {
 }
 
 /// The index bits of [`Slot::key`] (triangles beyond are not cached).
-const INDEX: u32 = (1 << 24) - 1;
-/// Bit 31 of [`Slot::key`]: no depth-grid values (declined).
+const INDEX: u32 = (1 << 20) - 1;
+/// Bit 31 of [`Slot::key`] alone: no depth-grid values (declined).
 const DECLINED: u32 = 1 << 31;
-/// Bit 30 of [`Slot::key`]: a solved plane ([`Remember::Plane`]), its fraction bits (at most 61) in bits 24 to 29.
+/// Bit 30 of [`Slot::key`] alone: a solved plane ([`Remember::Plane`]), its fraction bits (at most 61) in bits 24 to
+/// 29.
 const PLANE: u32 = 1 << 30;
+/// Bits 30 and 31 of [`Slot::key`]: a small triangle's constants ([`Remember::Small`]), its code's shift `s0` (at
+/// most 32) in bits 24 to 29 and, in bits 20 to 23, 1 more than its leading zeros where they are the same at every
+/// pixel (at most 8), else 0.
+const SMALL: u32 = DECLINED | PLANE;
 
 /// The cache's ring: `len` slots from `head`, of which the first `prev` were left by the previous band (in
 /// increasing triangle order, the order [`MeshFrame::for_each`] visits), the rest by the current one.
@@ -503,7 +510,16 @@ impl Cache<'_> {
                 let t = &e.t;
                 let join = |lo: u32, hi: u32| ((hi as u64) << 32 | lo as u64) as i64;
                 let v = [join(t[0], t[1]), join(t[2], t[3]), join(t[4], t[5])];
-                return Some(if e.key & PLANE != 0 {
+                return Some(if e.key & SMALL == SMALL {
+                    let lz = (e.key >> 20) & 15;
+                    Remember::Small(Kept {
+                        s_o: v[0] as u64,
+                        sx: v[1] as u64,
+                        sy: v[2] as u64,
+                        s0: (e.key >> 24) & 63,
+                        lz: (lz != 0).then(|| lz - 1),
+                    })
+                } else if e.key & PLANE != 0 {
                     Remember::Plane(Solved {
                         plane: Plane {
                             row: v[0],
@@ -527,6 +543,20 @@ impl Cache<'_> {
         if len < n {
             let at = (st.head.get() + len) % n;
             let (key, t) = match r {
+                // `s0 <= 32` and `lz <= 8` (`crate::small`'s module doc); a value beyond the key's bits is not kept.
+                Remember::Small(Kept { s0, lz, .. }) if s0 > 63 || lz.is_some_and(|z| z > 14) => {
+                    return
+                }
+                Remember::Small(Kept {
+                    s_o,
+                    sx,
+                    sy,
+                    s0,
+                    lz,
+                }) => (
+                    k | SMALL | s0 << 24 | lz.map_or(0, |z| z + 1) << 20,
+                    [s_o as i64, sx as i64, sy as i64],
+                ),
                 Remember::T(Some(t)) => (k, t),
                 Remember::T(None) => (k | DECLINED, [0; 3]),
                 Remember::Plane(Solved { plane, frac }) => (
@@ -1654,12 +1684,13 @@ mod tests {
     #[test]
     fn a_list_frame_draws_what_draw_draws_and_solves_each_plane_once() {
         use crate::setup::{PLANE_SOLVES, T_AT_SNAPPED_CALLS};
+        use crate::small::SMALL_CONSTANTS;
         use crate::{ColorBand, Vertex};
         use embedded_graphics_core::pixelcolor::{raw::RawU16, Rgb565};
         const W: usize = 96;
         const H: usize = 80;
         type Snapped = Vec<[(i32, i32); 3]>;
-        type Frame = (Vec<u16>, Vec<u16>, Stats, Snapped, Snapped);
+        type Frame = (Vec<u16>, Vec<u16>, Stats, Snapped, Snapped, Snapped);
         // Whether no triangle appears twice (the lists' triangles are distinct).
         fn once(v: &Snapped) -> bool {
             let mut v = v.clone();
@@ -1678,6 +1709,7 @@ mod tests {
             let mut stats = Stats::default();
             PLANE_SOLVES.with(|c| c.borrow_mut().clear());
             T_AT_SNAPPED_CALLS.with(|c| c.borrow_mut().clear());
+            SMALL_CONSTANTS.with(|c| c.borrow_mut().clear());
             let mut frame = cache.map(|c| c.list(tris));
             let mut bands: Vec<usize> = (0..H).step_by(rows).collect();
             if up {
@@ -1705,6 +1737,7 @@ mod tests {
                 stats,
                 PLANE_SOLVES.with(|c| c.take()),
                 T_AT_SNAPPED_CALLS.with(|c| c.take()),
+                SMALL_CONSTANTS.with(|c| c.take()),
             )
         }
         let mut state = 0x2545_f491_4f6c_dd1du64;
@@ -1714,7 +1747,8 @@ mod tests {
             state ^= state << 17;
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
-        let mut solved_some = false;
+        // (planes solved again in some band without the cache, small triangles' constants computed again)
+        let mut again = (false, false);
         for trial in 0..12 {
             let tris: Vec<[Vertex<Rgb565>; 3]> = (0..40)
                 .map(|k| {
@@ -1732,7 +1766,7 @@ mod tests {
                     })
                 })
                 .collect();
-            fn check<R: SpanRecip>(tris: &[[Vertex<Rgb565>; 3]], solved_some: &mut bool) {
+            fn check<R: SpanRecip>(tris: &[[Vertex<Rgb565>; 3]], again: &mut (bool, bool)) {
                 let mut cache = PlaneCache::<64>::new();
                 let whole = run::<R>(tris, H, None, false);
                 for rows in [1, 3, 8, 80] {
@@ -1752,16 +1786,21 @@ mod tests {
                     // where the list has no triangle the small-triangle path may take (on the fast tier, one it
                     // declines is solved again in each band: whether it declines may depend on the band).
                     assert!(once(&listed.4), "{} rows {rows}", R::NAME);
+                    // And each small triangle the small-triangle path draws has its depth constants computed once.
+                    assert!(once(&listed.5), "{} rows {rows}", R::NAME);
                     if !R::FAST_W16 || tris.iter().all(|t| !small_box(t)) {
                         assert!(once(&listed.3), "{} rows {rows}", R::NAME);
                     }
                     assert!(plain.3.len() >= listed.3.len() && plain.4.len() >= listed.4.len());
-                    *solved_some |= !once(&plain.3);
+                    assert!(plain.5.len() >= listed.5.len());
+                    again.0 |= !once(&plain.3);
+                    again.1 |= !once(&plain.5);
                     // Bottom to top: what the plain draw does, computed as often.
                     let up = run::<R>(tris, rows, Some(&mut cache), true);
                     let plain_up = run::<R>(tris, rows, None, true);
                     assert!(up.0 == plain.0 && up.1 == plain.1 && up.2 == plain.2);
                     assert!(up.3.len() == plain_up.3.len() && up.4.len() == plain_up.4.len());
+                    assert!(up.5.len() == plain_up.5.len());
                 }
             }
             // The small-triangle path's box: under 32 px wide and 126 px high, snapped.
@@ -1773,13 +1812,14 @@ mod tests {
             }
             let large: Vec<_> = tris.iter().copied().filter(|t| !small_box(t)).collect();
             for list in [&tris[..], &large[..]] {
-                check::<crate::recip::Fast>(list, &mut solved_some);
-                check::<crate::recip::FastDiv>(list, &mut solved_some);
-                check::<crate::recip::Exact>(list, &mut solved_some);
+                check::<crate::recip::Fast>(list, &mut again);
+                check::<crate::recip::FastDiv>(list, &mut again);
+                check::<crate::recip::Exact>(list, &mut again);
             }
         }
-        // The lists have triangles the exact solve sets up, in more than one band.
-        assert!(solved_some);
+        // The lists have triangles the exact solve sets up, and small ones the small-triangle path draws, in more
+        // than one band.
+        assert!(again.0 && again.1);
     }
 
     /// `trunc_bits` (the cores without an FPU) is `as i32` (the FPU's conversion) on every class of f32: a stride

@@ -344,12 +344,15 @@ impl<R: SpanRecip> Rasterizer<R> {
         }
     }
 
-    /// What a remembered [`t_at_snapped`] value or plane depends on besides the triangle: the strategy's way to it
-    /// (its seed, and whether it is of the fast tier, whose set-up differs) and the far plane (the vertices' `T`).
+    /// What a remembered [`t_at_snapped`] value, plane or small triangle's constants depend on besides the triangle:
+    /// the strategy's way to it (its seed, and whether it is of the fast tier, whose set-up differs), the far plane
+    /// (the vertices' `T`) and the near plane (the small-triangle path's range test, whose pass a remembered triangle
+    /// skips). Both planes are positive (`DepthRange::new`), so their sign bits carry the strategy's two.
     pub(crate) fn memo_tag(&self) -> u64 {
-        ((R::FAST_W16 as u64) << 33)
-            | ((R::DIV_SEED as u64) << 32)
-            | self.state.range.far().to_bits() as u64
+        let r = &self.state.range;
+        ((r.near().to_bits() as u64) << 32 | r.far().to_bits() as u64)
+            | (R::FAST_W16 as u64) << 63
+            | (R::DIV_SEED as u64) << 31
     }
 
     /// The fast tier's depth-grid values of `s` ([`t_at_snapped`], the strategy's way).
@@ -401,12 +404,14 @@ impl<R: SpanRecip> Rasterizer<R> {
         // or the solved plane of a triangle the small-triangle path never takes (a fact of the triangle, whatever
         // the band or the state: its box, or an exact-tier strategy).
         let mut solved = None;
+        let mut small_kept = None;
         let mut kept_row = None;
         if M::KEEPS {
             if let Some(last) = in_buffer() {
                 kept_row = Some(last);
                 match memo.take() {
                     Some(Remember::Plane(sv)) => solved = Some(sv),
+                    Some(Remember::Small(k)) => small_kept = Some(k),
                     Some(Remember::T(Some(t))) => s.fast_t = Some(t),
                     // Declined there (a steep plane): the general set-up solves it from the depth grid.
                     Some(Remember::T(None)) => Self::depth_grid(&mut s, v),
@@ -432,17 +437,43 @@ impl<R: SpanRecip> Rasterizer<R> {
             && write
             && !self.state.has_bias()
         {
-            // The strategy's seed (a constant of `R`: the other branch is not compiled into the firmware).
-            let small = if R::DIV_SEED {
-                crate::small::draw::<Divide, D>(target, depth, &s, &self.state, v[0].color())?
-            } else {
-                crate::small::draw::<Chord, D>(target, depth, &s, &self.state, v[0].color())?
+            // The strategy's seed and whether a memo keeps anything (constants: the other branches are not
+            // compiled into the firmware).
+            let (state, c) = (&self.state, v[0].color());
+            let small = match (R::DIV_SEED, M::KEEPS) {
+                (true, true) => {
+                    crate::small::draw::<Divide, D, true>(target, depth, &s, state, c, small_kept)?
+                }
+                (true, false) => {
+                    crate::small::draw::<Divide, D, false>(target, depth, &s, state, c, None)?
+                }
+                (false, true) => {
+                    crate::small::draw::<Chord, D, true>(target, depth, &s, state, c, small_kept)?
+                }
+                (false, false) => {
+                    crate::small::draw::<Chord, D, false>(target, depth, &s, state, c, None)?
+                }
             };
-            if let Some(stats) = small {
-                if let (true, Some(last)) = (M::KEEPS && !s.on_grid, kept_row) {
-                    memo.keep(Remember::T(s.fast_t), last);
+            if let Some((stats, kept)) = small {
+                if let (true, Some(last)) = (M::KEEPS, kept_row) {
+                    match kept {
+                        Some(k) => memo.keep(Remember::Small(k), last),
+                        // Culled, or no row in this band: the depth-grid values it computed.
+                        None if !s.on_grid && small_kept.is_none() => {
+                            memo.keep(Remember::T(s.fast_t), last)
+                        }
+                        None => {}
+                    }
                 }
                 return Ok(stats);
+            }
+        }
+        if small_kept.is_some() {
+            // Remembered for the small-triangle path, which did not draw it here (its conditions changed): the
+            // values the general set-up reads.
+            Self::depth_grid(&mut s, v);
+            if R::FAST_W16 && !s.on_grid {
+                s.fast_t = self.fast_t(&s);
             }
         }
         let (mut w, solved) =

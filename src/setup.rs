@@ -109,11 +109,12 @@ pub struct Solved {
 
 /// What a memo keeps of a triangle from one band of a frame for the next ([`TMemo`]): the fast tier's depth-grid
 /// values ([`t_at_snapped`]; `None` where declined), or, for a triangle the small-triangle path never takes, its
-/// solved plane.
+/// solved plane, or, for one it drew, its depth constants ([`crate::small::Kept`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Remember {
     T(Option<[i64; 3]>),
     Plane(Solved),
+    Small(crate::small::Kept),
 }
 
 /// Where [`crate::Rasterizer::draw_memo`] finds and leaves what it remembers of a triangle ([`Remember`]).

@@ -73,39 +73,47 @@ fn margin(t_max: u64) -> u64 {
     (t_max >> 32) + (1 << 17)
 }
 
+/// What a band keeps of a small triangle it drew for the next band of the frame ([`crate::setup::Remember::Small`]):
+/// `S` pre-shifted at the centre of the box's origin pixel (column `ox`, row `oy`) and its steps a column and a row,
+/// the code's shift `s0`, and the leading zeros where they are the same at every covered pixel (see `draw_as`). A
+/// function of the triangle (its snapped vertices and their `T`) and the far plane alone, so a remembered one draws
+/// exactly what a computed one does; the next band skips the depth range's checks, `T'`, the products of `S` and the
+/// leading zeros (on the Cortex-M0's W4, about half of this path's set-up).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Kept {
+    pub(crate) s_o: u64,
+    pub(crate) sx: u64,
+    pub(crate) sy: u64,
+    pub(crate) s0: u32,
+    pub(crate) lz: Option<u32>,
+}
+
 /// Draws the snapped triangle `s` in `color` if it is a small triangle this path takes (see the module doc), with
 /// `Less`, depth write and no bias (the caller's conditions). `Ok(None)`, having written nothing, where it does not
-/// apply: the general path then draws it.
+/// apply: the general path then draws it. `kept`: what an earlier band of the frame kept of it (then it is taken).
+/// With `KEEP`, also what to keep for the next band, where the triangle has rows below this band's.
 #[inline(never)]
-pub(crate) fn draw<S: FreshSeed, D: DrawTarget>(
+pub(crate) fn draw<S: FreshSeed, D: DrawTarget, const KEEP: bool>(
     target: &mut D,
     depth: &mut DepthBuffer<'_>,
     s: &Setup,
     state: &RenderState,
     color: D::Color,
-) -> Result<Option<Stats>, Error> {
-    draw_as::<S, D, ROWS_BY_DIVISION>(target, depth, s, state, color)
+    kept: Option<Kept>,
+) -> Result<Option<(Stats, Option<Kept>)>, Error> {
+    draw_as::<S, D, ROWS_BY_DIVISION, KEEP>(target, depth, s, state, color, kept)
 }
 
 /// [`draw`], finding each row's run by division (`DIV`) or by scanning (see [`ROWS_BY_DIVISION`]).
 #[inline(always)]
-fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
+fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool, const KEEP: bool>(
     target: &mut D,
     depth: &mut DepthBuffer<'_>,
     s: &Setup,
     state: &RenderState,
     color: D::Color,
-) -> Result<Option<Stats>, Error> {
-    // The depth-grid plane's `T` at the snapped vertices (the vertices' own where they lie on the snap grid): the
-    // barycentric sum over the snapped triangle below is then the depth-grid plane.
-    let st = if s.on_grid {
-        s.t
-    } else {
-        match s.fast_t {
-            Some(t) => t,
-            None => return Ok(None),
-        }
-    };
+    kept: Option<Kept>,
+) -> Result<Option<(Stats, Option<Kept>)>, Error> {
     let p = s.p;
     let (xmin, xmax) = (
         p[0].x.min(p[1].x).min(p[2].x),
@@ -127,34 +135,107 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
         ..Stats::default()
     };
     match state.cull {
-        _ if area == 0 => return Ok(Some(culled)),
-        Cull::Cw if area > 0 => return Ok(Some(culled)),
-        Cull::Ccw if area < 0 => return Ok(Some(culled)),
+        _ if area == 0 => return Ok(Some((culled, None))),
+        Cull::Cw if area > 0 => return Ok(Some((culled, None))),
+        Cull::Ccw if area < 0 => return Ok(Some((culled, None))),
         _ => {}
     }
-    let (q, t) = if area < 0 {
-        ([q[0], q[2], q[1]], [st[0], st[2], st[1]])
-    } else {
-        (q, st)
-    };
+    let q = if area < 0 { [q[0], q[2], q[1]] } else { q };
     let area2 = area.unsigned_abs() as u64;
-
-    // Depth range and the conditions of the module doc.
-    let t = t.map(|v| v as u64);
-    let (t_min, t_max) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
-    let e = margin(t_max);
-    let t_hi = state.range.t_max(s.frac);
-    // `2^F` from 32-bit pieces on the Cortex-M0 ([`shl64`]; `F <= 61`), where `1 << F` is a library call.
-    if t_min < e || t_min - e < shl64(1, s.frac) || t_max + e > t_hi || t_min < 1 << 56 {
-        return Ok(None);
-    }
-    let tp = t.map(|v| (v + (1 << 24)) >> 25); // T' = round(T / 2^25) in [2^31, 2^36]
-    let tp_max = tp[0].max(tp[1]).max(tp[2]);
-    let Some(sh) = 63u32.checked_sub(bits(area2) + bits(tp_max)) else {
-        return Ok(None);
+    // Rows whose centres lie in the box, less a horizontal bottom edge's own row, clipped to the buffer.
+    let pa = if area < 0 { [p[0], p[2], p[1]] } else { p };
+    let (j_first, j_last) = flat_rows(&pa, rows_of(&pa));
+    let j0 = j_first.max(depth.y0());
+    let j1 = j_last.min(depth.y0().saturating_add(depth.height() as i32 - 1));
+    // S at the centre of the box's origin column `ox` on row `j0`, and its steps per column and row; a covered
+    // pixel's column is at least `ox` (its centre is right of `xmin >= 256 ox`). The edge functions (less their
+    // top-left bias) at the same centre, for the scan.
+    let cy = ((j0 - oy) << SUBPIXEL_BITS) + 128;
+    let (mut e, mut ex, mut ey) = ([0i32; 3], [0i32; 3], [0i32; 3]);
+    // Without `KEEP` no band keeps anything (a constant: the branch is not compiled).
+    let (walk, keep) = match kept.filter(|_| KEEP) {
+        Some(_) if j0 > j1 => return Ok(Some((Stats::default(), None))),
+        Some(k) => {
+            if !DIV {
+                for (i, (e, (ex, ey))) in e
+                    .iter_mut()
+                    .zip(ex.iter_mut().zip(ey.iter_mut()))
+                    .enumerate()
+                {
+                    let (a, c) = (q[i], q[(i + 1) % 3]);
+                    let (ea, eb) = (a.1 - c.1, c.0 - a.0);
+                    let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0))); // 0 on a top or left edge
+                    (*e, *ex, *ey) = (
+                        ea * (128 - a.0) + eb * (cy - a.1) - bias,
+                        ea << SUBPIXEL_BITS,
+                        eb << SUBPIXEL_BITS,
+                    );
+                }
+            }
+            let (kn, _) = code_factor(area2);
+            // `S` (pre-shifted, modulo 2^64) moved from the origin's row to `j0`: the same bits as computed there.
+            let walk = Walk {
+                j0,
+                j1,
+                ox,
+                sr: k.s_o.wrapping_add(mul_small(k.sy, (j0 - oy) as u32)),
+                sx: k.sx,
+                sy: k.sy,
+                kn,
+                s0: k.s0,
+                lz: k.lz,
+            };
+            (walk, (j_last > j1).then_some(k))
+        }
+        // No row in the buffer: nothing to draw (the general path would find none either).
+        None if j0 > j1 => return Ok(Some((Stats::default(), None))),
+        None => {
+            let Some((walk, keep)) = constants::<KEEP>(
+                s,
+                state,
+                &q,
+                area,
+                area2,
+                (ox, oy),
+                (j0, j1, j_last),
+                cy,
+                (&mut e, &mut ex, &mut ey),
+            ) else {
+                return Ok(None);
+            };
+            (walk, keep)
+        }
     };
-    // K = 65535 2A = kn 2^kz, kn in [2^31, 2^32) rounded to nearest.
-    let k = mul_wide(65535, area2 as u32); // area2 < 2^29 (box under 32 x 126 px)
+    let scan = Scan {
+        e,
+        ex,
+        ey,
+        ncol: ((xmax - 128) >> SUBPIXEL_BITS) - ox + 1,
+    };
+    let stats = if DIV {
+        let Some(halves) = Halves::new(&pa, j0, j1, ox, oy) else {
+            return Ok(None);
+        };
+        walk.rows::<S, D, _>(target, depth, halves, color)?
+    } else {
+        walk.rows::<S, D, _>(target, depth, scan, color)?
+    };
+    Ok(Some((stats, if KEEP { keep } else { None })))
+}
+
+#[cfg(test)]
+std::thread_local! {
+    /// The snapped vertices of each triangle whose depth constants [`constants`] computed and accepted, on this
+    /// thread (the memo's tests count what it saves).
+    pub(crate) static SMALL_CONSTANTS: core::cell::RefCell<std::vec::Vec<[(i32, i32); 3]>> =
+        const { core::cell::RefCell::new(std::vec::Vec::new()) };
+}
+
+/// `K = 65535 2A = kn 2^kz` for the doubled area `area2` (below `2^29`: the box is under 32 x 126 px), `kn` in
+/// `[2^31, 2^32)` rounded to nearest.
+#[inline(always)]
+fn code_factor(area2: u64) -> (u32, i32) {
+    let k = mul_wide(65535, area2 as u32);
     let kb = bits(k) as i32;
     let (kn, kz) = if kb > 32 {
         let r = shr64(k + shl64(1, (kb - 33) as u32), (kb - 32) as u32);
@@ -166,30 +247,57 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
     } else {
         (shl64(k, (32 - kb) as u32), kb - 32)
     };
+    (kn as u32, kz)
+}
+
+/// [`draw_as`]'s depth constants of a triangle no band kept ([`Kept`]): the walk from row `j0` (and, with `KEEP`,
+/// what to keep where the triangle has rows below `j1`), and the edge functions at row `j0` for the scan; `None`
+/// where the triangle is not one this path takes.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn constants<const KEEP: bool>(
+    s: &Setup,
+    state: &RenderState,
+    q: &[(i32, i32); 3],
+    area: i32,
+    area2: u64,
+    (ox, oy): (i32, i32),
+    (j0, j1, j_last): (i32, i32, i32),
+    cy: i32,
+    (e, ex, ey): (&mut [i32; 3], &mut [i32; 3], &mut [i32; 3]),
+) -> Option<(Walk, Option<Kept>)> {
+    // The depth-grid plane's `T` at the snapped vertices (the vertices' own where they lie on the snap grid): the
+    // barycentric sum over the snapped triangle below is then the depth-grid plane.
+    let st = if s.on_grid { s.t } else { s.fast_t? };
+    let t = if area < 0 { [st[0], st[2], st[1]] } else { st };
+
+    // Depth range and the conditions of the module doc.
+    let t = t.map(|v| v as u64);
+    let (t_min, t_max) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+    let margin = margin(t_max);
+    let t_hi = state.range.t_max(s.frac);
+    // `2^F` from 32-bit pieces on the Cortex-M0 ([`shl64`]; `F <= 61`), where `1 << F` is a library call.
+    if t_min < margin
+        || t_min - margin < shl64(1, s.frac)
+        || t_max + margin > t_hi
+        || t_min < 1 << 56
+    {
+        return None;
+    }
+    let tp = t.map(|v| (v + (1 << 24)) >> 25); // T' = round(T / 2^25) in [2^31, 2^36]
+    let tp_max = tp[0].max(tp[1]).max(tp[2]);
+    let sh = 63u32.checked_sub(bits(area2) + bits(tp_max))?;
+    let (kn, kz) = code_factor(area2);
     let s0 = 86 - kz - s.frac as i32 - sh as i32; // the code's shift is s0 - lz, lz >= 1
     if s0 > 32 {
-        return Ok(None);
+        return None;
     }
-    let (kn, s0) = (kn as u32, s0 as u32);
+    let s0 = s0 as u32;
 
     // S weights: the edge k -> k+1 carries T' of vertex k + 2.
     let w = [tp[2], tp[0], tp[1]];
-    // Rows whose centres lie in the box, less a horizontal bottom edge's own row, clipped to the buffer.
-    let pa = if area < 0 { [p[0], p[2], p[1]] } else { p };
-    let (j_first, j_last) = flat_rows(&pa, rows_of(&pa));
-    let j0 = j_first.max(depth.y0());
-    let j1 = j_last.min(depth.y0().saturating_add(depth.height() as i32 - 1));
-    if j0 > j1 {
-        return Ok(Some(Stats::default()));
-    }
-    // S at the centre of the box's origin column `ox` on row `j0`, and its steps per column and row; a covered
-    // pixel's column is at least `ox` (its centre is right of `xmin >= 256 ox`). The edge functions (less their
-    // top-left bias) at the same centre, for the scan.
-    let cy = ((j0 - oy) << SUBPIXEL_BITS) + 128;
     #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
     let (mut sr, mut sx, mut sy) = (0u64, 0u64, 0u64);
-    // Three arrays rather than the `Scan` filled in place (a zeroed struct: a `memclr` call on the Cortex-M0).
-    let (mut e, mut ex, mut ey) = ([0i32; 3], [0i32; 3], [0i32; 3]);
     // The Cortex-M0 (no 32 x 32 -> 64 multiply) takes `S` by differences ([`s_by_differences`]), the other cores
     // the sum of the three products in the loop; chosen by `cfg`, not by a constant's branch (with the M0's code
     // present but not taken, LLVM allocated this function's registers differently on RV32: W3 +1.6%).
@@ -216,13 +324,7 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
     #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
     let (sr, sx, sy, (s_max, s_min)) = {
         let tp_min = tp[0].min(tp[1]).min(tp[2]);
-        s_by_differences(&er_m0, &ex, &ey, &w, area2 as i32, tp_max, tp_min)
-    };
-    let scan = Scan {
-        e,
-        ex,
-        ey,
-        ncol: ((xmax - 128) >> SUBPIXEL_BITS) - ox + 1,
+        s_by_differences(&er_m0, ex, ey, &w, area2 as i32, tp_max, tp_min)
     };
     // Every covered pixel's `S 2^sh` lies between its values at the smallest and the largest vertex `T'` (a convex
     // combination): where those two have the same leading zeros, so has every pixel, and the loop takes them once.
@@ -255,14 +357,17 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool>(
         s0,
         lz: same.then_some(lz),
     };
-    if DIV {
-        let Some(halves) = Halves::new(&pa, j0, j1, ox, oy) else {
-            return Ok(None);
-        };
-        walk.rows::<S, D, _>(target, depth, halves, color).map(Some)
-    } else {
-        walk.rows::<S, D, _>(target, depth, scan, color).map(Some)
-    }
+    #[cfg(test)]
+    SMALL_CONSTANTS.with(|c| c.borrow_mut().push(s.p.map(|p| (p.x, p.y))));
+    // `S` moved back to the origin's row (exact modulo 2^64, as the walk), for a band that starts lower.
+    let keep = (KEEP && j_last > j1).then(|| Kept {
+        s_o: walk.sr.wrapping_sub(mul_small(walk.sy, (j0 - oy) as u32)),
+        sx: walk.sx,
+        sy: walk.sy,
+        s0,
+        lz: walk.lz,
+    });
+    Some((walk, keep))
 }
 
 /// How the rows find their covered runs: by division where the core divides in one instruction (the Cortex-M4 and
@@ -718,6 +823,27 @@ fn partial<D: DrawTarget>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`draw_as_t`] of `s` into `f` in `On`, the core's way ([`ROWS_BY_DIVISION`]).
+    fn drawn<S: FreshSeed>(
+        f: &mut Frame,
+        db: &mut DepthBuffer<'_>,
+        s: &Setup,
+        state: &RenderState,
+    ) -> Option<Stats> {
+        draw_as_t::<S, _, ROWS_BY_DIVISION>(f, db, s, state, BinaryColor::On).unwrap()
+    }
+
+    /// [`draw_as`] without a memo: the stats, where taken.
+    fn draw_as_t<S: FreshSeed, D: DrawTarget, const DIV: bool>(
+        target: &mut D,
+        depth: &mut DepthBuffer<'_>,
+        s: &Setup,
+        state: &RenderState,
+        color: D::Color,
+    ) -> Result<Option<Stats>, Error> {
+        Ok(draw_as::<S, D, DIV, false>(target, depth, s, state, color, None)?.map(|(st, _)| st))
+    }
     use crate::fast::{Chord, Divide};
     use crate::raster::Rasterizer;
     use crate::recip::Fast;
@@ -798,28 +924,28 @@ mod tests {
                 let mut f = Frame(vec![0; 64 * 64]);
                 let mut db = DepthBuffer::band(&mut d, 64, y0, band as u16).unwrap();
                 let st = match (m, k % 4 == 1) {
-                    (0, false) => draw_as::<Chord, _, true>(
+                    (0, false) => draw_as_t::<Chord, _, true>(
                         &mut f,
                         &mut db,
                         &setup,
                         &r.state,
                         BinaryColor::On,
                     ),
-                    (1, false) => draw_as::<Chord, _, false>(
+                    (1, false) => draw_as_t::<Chord, _, false>(
                         &mut f,
                         &mut db,
                         &setup,
                         &r.state,
                         BinaryColor::On,
                     ),
-                    (0, true) => draw_as::<Divide, _, true>(
+                    (0, true) => draw_as_t::<Divide, _, true>(
                         &mut f,
                         &mut db,
                         &setup,
                         &r.state,
                         BinaryColor::On,
                     ),
-                    _ => draw_as::<Divide, _, false>(
+                    _ => draw_as_t::<Divide, _, false>(
                         &mut f,
                         &mut db,
                         &setup,
@@ -911,14 +1037,28 @@ mod tests {
                 let mut db = DepthBuffer::band(&mut d, 64, y0, band as u16).unwrap();
                 let st = match m {
                     // The entry the rasterizer calls (by division on the host).
-                    0 => draw::<Chord, _>(&mut f, &mut db, &setup, &state, BinaryColor::On),
-                    1 => {
-                        draw_as::<Chord, _, false>(&mut f, &mut db, &setup, &state, BinaryColor::On)
-                    }
-                    2 => {
-                        draw_as::<Divide, _, true>(&mut f, &mut db, &setup, &state, BinaryColor::On)
-                    }
-                    _ => draw_as::<Divide, _, false>(
+                    0 => draw_as_t::<Chord, _, ROWS_BY_DIVISION>(
+                        &mut f,
+                        &mut db,
+                        &setup,
+                        &state,
+                        BinaryColor::On,
+                    ),
+                    1 => draw_as_t::<Chord, _, false>(
+                        &mut f,
+                        &mut db,
+                        &setup,
+                        &state,
+                        BinaryColor::On,
+                    ),
+                    2 => draw_as_t::<Divide, _, true>(
+                        &mut f,
+                        &mut db,
+                        &setup,
+                        &state,
+                        BinaryColor::On,
+                    ),
+                    _ => draw_as_t::<Divide, _, false>(
                         &mut f,
                         &mut db,
                         &setup,
@@ -970,8 +1110,13 @@ mod tests {
                     // `Less` is strict: the same triangle again writes nothing.
                     let mut again = Frame(vec![0; 64 * 192]);
                     let mut db = DepthBuffer::band(&mut d, 64, y0, band as u16).unwrap();
-                    let st2 =
-                        draw::<Chord, _>(&mut again, &mut db, &setup, &state, BinaryColor::On);
+                    let st2 = draw_as_t::<Chord, _, ROWS_BY_DIVISION>(
+                        &mut again,
+                        &mut db,
+                        &setup,
+                        &state,
+                        BinaryColor::On,
+                    );
                     assert_eq!(st2.unwrap().map(|s| s.written), Some(0), "triangle {k}");
                     assert!(again.0.iter().all(|&c| c == 0), "triangle {k}");
                 }
@@ -1012,7 +1157,7 @@ mod tests {
             let mut d = vec![u16::MAX; 64 * 192];
             let mut f = Frame(vec![0; 64 * 192]);
             let mut db = DepthBuffer::new(&mut d, 64, 192).unwrap();
-            let st = draw::<Chord, _>(&mut f, &mut db, &setup, &r.state, BinaryColor::On).unwrap();
+            let st = drawn::<Chord>(&mut f, &mut db, &setup, &r.state);
             if st.is_none() {
                 assert!(d.iter().all(|&c| c == u16::MAX) && f.0.iter().all(|&c| c == 0));
             }
@@ -1102,14 +1247,14 @@ mod tests {
         let mut d = vec![u16::MAX; 64 * 64];
         let mut f = Frame(vec![0; 64 * 64]);
         let mut db = DepthBuffer::new(&mut d, 64, 64).unwrap();
-        let st = draw::<Chord, _>(&mut f, &mut db, &setup, &r.state, BinaryColor::On).unwrap();
+        let st = drawn::<Chord>(&mut f, &mut db, &setup, &r.state);
         assert!(st.is_none());
         // Moved inside by more than the margin (t = 1 + 2^-22 + ...), the same triangle is taken.
         let mut v2 = v;
         v2[0].rhw = f32::from_bits(0x3c80_0b4d + 64);
         let setup = r.setup(&v2).unwrap();
         let mut db = DepthBuffer::new(&mut d, 64, 64).unwrap();
-        let st = draw::<Chord, _>(&mut f, &mut db, &setup, &r.state, BinaryColor::On).unwrap();
+        let st = drawn::<Chord>(&mut f, &mut db, &setup, &r.state);
         assert!(st.is_some());
     }
 
@@ -1139,7 +1284,7 @@ mod tests {
             let mut d = vec![u16::MAX; 64 * 64];
             let mut f = Frame(vec![0; 64 * 64]);
             let mut db = DepthBuffer::new(&mut d, 64, 64).unwrap();
-            let st = draw::<Chord, _>(&mut f, &mut db, &setup, &r.state, BinaryColor::On).unwrap();
+            let st = drawn::<Chord>(&mut f, &mut db, &setup, &r.state);
             assert_eq!(st.is_some(), take, "far {far}");
         }
     }
@@ -1244,10 +1389,7 @@ mod tests {
                 d.fill(u16::MAX);
                 let mut f = Frame(vec![0; 64 * 64]);
                 let mut db = DepthBuffer::new(&mut d, 64, 64).unwrap();
-                if draw::<S, _>(&mut f, &mut db, &setup, &r.state, BinaryColor::On)
-                    .unwrap()
-                    .is_none()
-                {
+                if drawn::<S>(&mut f, &mut db, &setup, &r.state).is_none() {
                     continue;
                 }
                 for &c in d.iter().filter(|&&c| c != u16::MAX) {
