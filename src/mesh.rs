@@ -511,14 +511,17 @@ impl Cache<'_> {
                 let join = |lo: u32, hi: u32| ((hi as u64) << 32 | lo as u64) as i64;
                 let v = [join(t[0], t[1]), join(t[2], t[3]), join(t[4], t[5])];
                 return Some(if e.key & SMALL == SMALL {
-                    let lz = (e.key >> 20) & 15;
-                    Remember::Small(Kept {
-                        s_o: v[0] as u64,
-                        sx: v[1] as u64,
-                        sy: v[2] as u64,
-                        s0: (e.key >> 24) & 63,
-                        lz: (lz != 0).then(|| lz - 1),
-                    })
+                    // Not zero: it was kept from a `Kept` (`s0 >= 1`).
+                    let shifts = ((e.key >> 24) & 63) | ((e.key >> 20) & 15) << 8;
+                    match core::num::NonZeroU16::new(shifts as u16) {
+                        Some(shifts) => Remember::Small(Kept {
+                            s_o: v[0] as u64,
+                            sx: v[1] as u64,
+                            sy: v[2] as u64,
+                            shifts,
+                        }),
+                        None => return None,
+                    }
                 } else if e.key & PLANE != 0 {
                     Remember::Plane(Solved {
                         plane: Plane {
@@ -544,19 +547,23 @@ impl Cache<'_> {
             let at = (st.head.get() + len) % n;
             let (key, t) = match r {
                 // `s0 <= 32` and `lz <= 8` (`crate::small`'s module doc); a value beyond the key's bits is not kept.
-                Remember::Small(Kept { s0, lz, .. }) if s0 > 63 || lz.is_some_and(|z| z > 14) => {
+                Remember::Small(Kept { shifts, .. })
+                    if shifts.get() & 0xff > 63 || shifts.get() >> 8 > 15 =>
+                {
                     return
                 }
                 Remember::Small(Kept {
                     s_o,
                     sx,
                     sy,
-                    s0,
-                    lz,
-                }) => (
-                    k | SMALL | s0 << 24 | lz.map_or(0, |z| z + 1) << 20,
-                    [s_o as i64, sx as i64, sy as i64],
-                ),
+                    shifts,
+                }) => {
+                    let z = shifts.get() as u32;
+                    (
+                        k | SMALL | (z & 0xff) << 24 | (z >> 8) << 20,
+                        [s_o as i64, sx as i64, sy as i64],
+                    )
+                }
                 Remember::T(Some(t)) => (k, t),
                 Remember::T(None) => (k | DECLINED, [0; 3]),
                 Remember::Plane(Solved { plane, frac }) => (

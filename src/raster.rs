@@ -405,13 +405,14 @@ impl<R: SpanRecip> Rasterizer<R> {
         // the band or the state: its box, or an exact-tier strategy).
         let mut solved = None;
         let mut small_kept = None;
+        let mut remembered_small = false;
         let mut kept_row = None;
         if M::KEEPS {
             if let Some(last) = in_buffer() {
                 kept_row = Some(last);
                 match memo.take() {
                     Some(Remember::Plane(sv)) => solved = Some(sv),
-                    Some(Remember::Small(k)) => small_kept = Some(k),
+                    Some(Remember::Small(k)) => (small_kept, remembered_small) = (Some(k), true),
                     Some(Remember::T(Some(t))) => s.fast_t = Some(t),
                     // Declined there (a steep plane): the general set-up solves it from the depth grid.
                     Some(Remember::T(None)) => Self::depth_grid(&mut s, v),
@@ -426,8 +427,14 @@ impl<R: SpanRecip> Rasterizer<R> {
         } else if R::FAST_W16 && !s.on_grid && in_buffer().is_some() {
             s.fast_t = self.fast_t(&s);
         }
+        // (A remembered small triangle's draw reads no depth-grid values: its constants stand for them.)
         #[cfg(test)]
-        if R::FAST_W16 && !s.on_grid && solved.is_none() && in_buffer().is_some() {
+        if R::FAST_W16
+            && !s.on_grid
+            && solved.is_none()
+            && !remembered_small
+            && in_buffer().is_some()
+        {
             FAST_T_USED.with(|c| c.borrow_mut().push((s.p.map(|p| (p.x, p.y)), s.fast_t)));
         }
         // A remembered plane: a triangle the small-triangle path declines.
@@ -440,26 +447,28 @@ impl<R: SpanRecip> Rasterizer<R> {
             // The strategy's seed and whether a memo keeps anything (constants: the other branches are not
             // compiled into the firmware).
             let (state, c) = (&self.state, v[0].color());
+            // In: what a band remembered; out: what to keep.
+            let k = &mut small_kept;
             let small = match (R::DIV_SEED, M::KEEPS) {
                 (true, true) => {
-                    crate::small::draw::<Divide, D, true>(target, depth, &s, state, c, small_kept)?
+                    crate::small::draw::<Divide, D, true>(target, depth, &s, state, c, k)?
                 }
                 (true, false) => {
-                    crate::small::draw::<Divide, D, false>(target, depth, &s, state, c, None)?
+                    crate::small::draw::<Divide, D, false>(target, depth, &s, state, c, k)?
                 }
                 (false, true) => {
-                    crate::small::draw::<Chord, D, true>(target, depth, &s, state, c, small_kept)?
+                    crate::small::draw::<Chord, D, true>(target, depth, &s, state, c, k)?
                 }
                 (false, false) => {
-                    crate::small::draw::<Chord, D, false>(target, depth, &s, state, c, None)?
+                    crate::small::draw::<Chord, D, false>(target, depth, &s, state, c, k)?
                 }
             };
-            if let Some((stats, kept)) = small {
+            if let Some(stats) = small {
                 if let (true, Some(last)) = (M::KEEPS, kept_row) {
-                    match kept {
+                    match small_kept {
                         Some(k) => memo.keep(Remember::Small(k), last),
                         // Culled, or no row in this band: the depth-grid values it computed.
-                        None if !s.on_grid && small_kept.is_none() => {
+                        None if !s.on_grid && !remembered_small => {
                             memo.keep(Remember::T(s.fast_t), last)
                         }
                         None => {}
@@ -468,7 +477,7 @@ impl<R: SpanRecip> Rasterizer<R> {
                 return Ok(stats);
             }
         }
-        if small_kept.is_some() {
+        if remembered_small {
             // Remembered for the small-triangle path, which did not draw it here (its conditions changed): the
             // values the general set-up reads.
             Self::depth_grid(&mut s, v);

@@ -84,14 +84,31 @@ pub struct Kept {
     pub(crate) s_o: u64,
     pub(crate) sx: u64,
     pub(crate) sy: u64,
-    pub(crate) s0: u32,
-    pub(crate) lz: Option<u32>,
+    /// `s0` (at most 32, at least 1) in the low byte, and in the high byte 1 more than the leading zeros where they
+    /// are the same at every pixel (at most 8), else 0: not zero, so an `Option<Kept>` takes no more room (the
+    /// Cortex-M0's stack).
+    pub(crate) shifts: core::num::NonZeroU16,
+}
+
+impl Kept {
+    /// The code's shift `s0`.
+    #[inline(always)]
+    pub(crate) fn s0(&self) -> u32 {
+        (self.shifts.get() & 0xff) as u32
+    }
+    /// The leading zeros of `S` where they are the same at every covered pixel.
+    #[inline(always)]
+    pub(crate) fn lz(&self) -> Option<u32> {
+        let z = (self.shifts.get() >> 8) as u32;
+        (z != 0).then(|| z - 1)
+    }
 }
 
 /// Draws the snapped triangle `s` in `color` if it is a small triangle this path takes (see the module doc), with
 /// `Less`, depth write and no bias (the caller's conditions). `Ok(None)`, having written nothing, where it does not
-/// apply: the general path then draws it. `kept`: what an earlier band of the frame kept of it (then it is taken).
-/// With `KEEP`, also what to keep for the next band, where the triangle has rows below this band's.
+/// apply: the general path then draws it. With `KEEP`, `kept` holds on entry what an earlier band of the frame kept
+/// of it (then it is taken), and on return what to keep for the next band, where the triangle has rows below this
+/// band's (`None` otherwise; one place for both, for the Cortex-M0's stack).
 #[inline(never)]
 pub(crate) fn draw<S: FreshSeed, D: DrawTarget, const KEEP: bool>(
     target: &mut D,
@@ -99,8 +116,8 @@ pub(crate) fn draw<S: FreshSeed, D: DrawTarget, const KEEP: bool>(
     s: &Setup,
     state: &RenderState,
     color: D::Color,
-    kept: Option<Kept>,
-) -> Result<Option<(Stats, Option<Kept>)>, Error> {
+    kept: &mut Option<Kept>,
+) -> Result<Option<Stats>, Error> {
     draw_as::<S, D, ROWS_BY_DIVISION, KEEP>(target, depth, s, state, color, kept)
 }
 
@@ -112,8 +129,8 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool, const KEEP: bool>(
     s: &Setup,
     state: &RenderState,
     color: D::Color,
-    kept: Option<Kept>,
-) -> Result<Option<(Stats, Option<Kept>)>, Error> {
+    kept: &mut Option<Kept>,
+) -> Result<Option<Stats>, Error> {
     let p = s.p;
     let (xmin, xmax) = (
         p[0].x.min(p[1].x).min(p[2].x),
@@ -135,9 +152,9 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool, const KEEP: bool>(
         ..Stats::default()
     };
     match state.cull {
-        _ if area == 0 => return Ok(Some((culled, None))),
-        Cull::Cw if area > 0 => return Ok(Some((culled, None))),
-        Cull::Ccw if area < 0 => return Ok(Some((culled, None))),
+        _ if area == 0 => return Ok(Some(culled)),
+        Cull::Cw if area > 0 => return Ok(Some(culled)),
+        Cull::Ccw if area < 0 => return Ok(Some(culled)),
         _ => {}
     }
     let q = if area < 0 { [q[0], q[2], q[1]] } else { q };
@@ -153,8 +170,8 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool, const KEEP: bool>(
     let cy = ((j0 - oy) << SUBPIXEL_BITS) + 128;
     let (mut e, mut ex, mut ey) = ([0i32; 3], [0i32; 3], [0i32; 3]);
     // Without `KEEP` no band keeps anything (a constant: the branch is not compiled).
-    let (walk, keep) = match kept.filter(|_| KEEP) {
-        Some(_) if j0 > j1 => return Ok(Some((Stats::default(), None))),
+    let (walk, keep) = match kept.take().filter(|_| KEEP) {
+        Some(_) if j0 > j1 => return Ok(Some(Stats::default())),
         Some(k) => {
             if !DIV {
                 for (i, (e, (ex, ey))) in e
@@ -182,13 +199,13 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool, const KEEP: bool>(
                 sx: k.sx,
                 sy: k.sy,
                 kn,
-                s0: k.s0,
-                lz: k.lz,
+                s0: k.s0(),
+                lz: k.lz(),
             };
             (walk, (j_last > j1).then_some(k))
         }
         // No row in the buffer: nothing to draw (the general path would find none either).
-        None if j0 > j1 => return Ok(Some((Stats::default(), None))),
+        None if j0 > j1 => return Ok(Some(Stats::default())),
         None => {
             let Some((walk, keep)) = constants::<KEEP>(
                 s,
@@ -220,7 +237,10 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool, const KEEP: bool>(
     } else {
         walk.rows::<S, D, _>(target, depth, scan, color)?
     };
-    Ok(Some((stats, if KEEP { keep } else { None })))
+    if KEEP {
+        *kept = keep;
+    }
+    Ok(Some(stats))
 }
 
 #[cfg(test)]
@@ -360,13 +380,17 @@ fn constants<const KEEP: bool>(
     #[cfg(test)]
     SMALL_CONSTANTS.with(|c| c.borrow_mut().push(s.p.map(|p| (p.x, p.y))));
     // `S` moved back to the origin's row (exact modulo 2^64, as the walk), for a band that starts lower.
-    let keep = (KEEP && j_last > j1).then(|| Kept {
-        s_o: walk.sr.wrapping_sub(mul_small(walk.sy, (j0 - oy) as u32)),
-        sx: walk.sx,
-        sy: walk.sy,
-        s0,
-        lz: walk.lz,
-    });
+    // `s0 <= 32` and `lz <= 32`: a byte each.
+    let shifts = s0 | walk.lz.map_or(0, |z| z + 1) << 8;
+    let keep = match core::num::NonZeroU16::new(shifts as u16) {
+        Some(shifts) if KEEP && j_last > j1 => Some(Kept {
+            s_o: walk.sr.wrapping_sub(mul_small(walk.sy, (j0 - oy) as u32)),
+            sx: walk.sx,
+            sy: walk.sy,
+            shifts,
+        }),
+        _ => None,
+    };
     Some((walk, keep))
 }
 
@@ -842,7 +866,7 @@ mod tests {
         state: &RenderState,
         color: D::Color,
     ) -> Result<Option<Stats>, Error> {
-        Ok(draw_as::<S, D, DIV, false>(target, depth, s, state, color, None)?.map(|(st, _)| st))
+        draw_as::<S, D, DIV, false>(target, depth, s, state, color, &mut None)
     }
     use crate::fast::{Chord, Divide};
     use crate::raster::Rasterizer;
