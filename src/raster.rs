@@ -79,17 +79,29 @@ impl<R: WSpan> Rasterizer<R> {
         &self,
         v: &[V; N],
     ) -> Result<Setup<N>, Error> {
-        let mut s = self.setup_snapped(v)?;
+        let (mut s, te) = self.setup_unrounded(v)?;
+        Self::round_t(&mut s, te);
         Self::depth_grid(&mut s, v);
         Ok(s)
     }
 
-    /// [`Rasterizer::setup`] without the depth grid (`q` left at the origin): for a draw that may not need it (a
-    /// band whose memo holds the triangle's values; [`Rasterizer::depth_grid`] fills it where it does).
-    pub(crate) fn setup_snapped<V: VertexInput, const N: usize>(
+    /// `T` of each vertex, rounded to the common fraction bits: from [`Rasterizer::setup_unrounded`]'s exact
+    /// products (`s.t` their mantissas, `te` their exponents).
+    #[inline(always)]
+    pub(crate) fn round_t<const N: usize>(s: &mut Setup<N>, te: [i32; N]) {
+        for (t, e) in s.t.iter_mut().zip(te) {
+            *t = round_shift(*t as u64, e + s.frac as i32) as i64;
+        }
+    }
+
+    /// [`Rasterizer::setup`] with each vertex's `T` left as the exact product `s.t[k] 2^te[k]` (the mantissas below
+    /// `2^56`) and no depth grid (`q` at the origin), for a draw whose memo may stand in for them
+    /// ([`Rasterizer::round_t`] and [`Rasterizer::depth_grid`] compute them where it does not). Every check of the
+    /// input is made here.
+    pub(crate) fn setup_unrounded<V: VertexInput, const N: usize>(
         &self,
         v: &[V; N],
-    ) -> Result<Setup<N>, Error> {
+    ) -> Result<(Setup<N>, [i32; N]), Error> {
         let (_, fm, fe) = split(self.state.range.far()).ok_or(Error::NonFinite)?;
         let mut p = [Sub { x: 0, y: 0 }; N];
         let mut on_grid = true;
@@ -112,17 +124,19 @@ impl<R: WSpan> Rasterizer<R> {
         }
         // F = 61 - bits(floor(t_max)), t_max < 2^30.
         let frac = (61 - int_bits) as u32;
-        let t = tm.map(|(m, e)| round_shift(m, e + frac as i32) as i64);
-        Ok(Setup {
-            p,
-            on_grid,
-            q: [Sub { x: 0, y: 0 }; N],
-            dbits: SUBPIXEL_BITS,
-            dorigin: (0, 0),
-            fast_t: None,
-            t,
-            frac,
-        })
+        Ok((
+            Setup {
+                p,
+                on_grid,
+                q: [Sub { x: 0, y: 0 }; N],
+                dbits: SUBPIXEL_BITS,
+                dorigin: (0, 0),
+                fast_t: None,
+                t: tm.map(|(m, _)| m as i64),
+                frac,
+            },
+            tm.map(|(_, e)| e),
+        ))
     }
 
     /// A triangle's vertices `v` (snapped and checked as `s`) on the depth grid, where it is off the snap grid: `q`,
@@ -382,11 +396,12 @@ impl<R: SpanRecip> Rasterizer<R> {
     {
         let (cmp, write) = self.w16_test()?;
         depth.note_compare(cmp, write);
-        // With a memo, the depth grid only where what it remembered does not stand in for it (below).
-        let mut s = if M::KEEPS {
-            self.setup_snapped(v)?
+        // With a memo, the vertices' `T` rounded and the depth grid only where what it remembered does not stand in
+        // for them (below).
+        let (mut s, te) = if M::KEEPS {
+            self.setup_unrounded(v)?
         } else {
-            self.setup(v)?
+            (self.setup(v)?, [0; 3])
         };
         // Only for a triangle with rows in the buffer (a band's draws include triangles that only come near it):
         // one that has none draws nothing either way, and both paths find that before they look at `fast_t`.
@@ -410,9 +425,15 @@ impl<R: SpanRecip> Rasterizer<R> {
         if M::KEEPS {
             if let Some(last) = in_buffer() {
                 kept_row = Some(last);
-                match memo.take() {
+                let taken = memo.take();
+                if let Some(Remember::Small(k)) = taken {
+                    (small_kept, remembered_small) = (Some(k), true);
+                } else {
+                    Self::round_t(&mut s, te);
+                }
+                match taken {
                     Some(Remember::Plane(sv)) => solved = Some(sv),
-                    Some(Remember::Small(k)) => (small_kept, remembered_small) = (Some(k), true),
+                    Some(Remember::Small(_)) => {}
                     Some(Remember::T(Some(t))) => s.fast_t = Some(t),
                     // Declined there (a steep plane): the general set-up solves it from the depth grid.
                     Some(Remember::T(None)) => Self::depth_grid(&mut s, v),
@@ -423,6 +444,8 @@ impl<R: SpanRecip> Rasterizer<R> {
                         }
                     }
                 }
+            } else {
+                Self::round_t(&mut s, te);
             }
         } else if R::FAST_W16 && !s.on_grid && in_buffer().is_some() {
             s.fast_t = self.fast_t(&s);
@@ -480,6 +503,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         if remembered_small {
             // Remembered for the small-triangle path, which did not draw it here (its conditions changed): the
             // values the general set-up reads.
+            Self::round_t(&mut s, te);
             Self::depth_grid(&mut s, v);
             if R::FAST_W16 && !s.on_grid {
                 s.fast_t = self.fast_t(&s);
