@@ -150,10 +150,12 @@ struct Bins<'a> {
 /// given, evaluated at the snapped ones: about 1,690 instructions a triangle on the Cortex-M0, a fifth of W4's
 /// frame there). The cache keeps those values for the triangles that reach the next band, so each is computed
 /// once a frame; for a triangle too large for the small-triangle path it keeps the solved plane of `T` instead (the
-/// exact solve, three 128-bit divisions). Both are functions of the triangle alone, so the frames are the same with
-/// and without the cache; a full cache just computes the values again. Triangle lists use it too
-/// ([`PlaneCache::list`]). Bands must come in order, top to bottom, for it to help: a band that
-/// does not start where the previous one ended, a change of the far plane or of the strategy empties it.
+/// exact solve, three 128-bit divisions), and for a small triangle that path drew, its depth constants (the next
+/// band skips the range tests, the products of its depth sum and their leading zeros). All are functions of the
+/// triangle alone, so the frames are the same with and without the cache; a full cache just computes the values
+/// again. Triangle lists use it too ([`PlaneCache::list`]). Bands must come in order, top to bottom, for it to help:
+/// a band that does not start where the previous one ended, a change of the depth range or of the strategy empties
+/// it. Triangles from index 2^20 on are not cached.
 ///
 /// A frame in bands of 8 rows, transformed once, binned by rows and cached (all in caller storage):
 /// ```
@@ -225,7 +227,8 @@ impl<const N: usize> PlaneCache<N> {
     /// (the cache is emptied here). A triangle that reaches the next band is set up there from what this one
     /// remembered: its depth-grid values on the fast tier (as a [`CachedFrame`]'s), or, for a triangle too large for
     /// the small-triangle path, its solved plane of `T` (the exact solve: on the Cortex-M0 some 4,000 instructions,
-    /// with its divisions). The frame borrows the list, so triangle `k` is the same in every band.
+    /// with its divisions), or, for a small triangle that path drew, its depth constants. The frame borrows the list,
+    /// so triangle `k` is the same in every band.
     ///
     /// ```
     /// use embedded_graphics_core::pixelcolor::Rgb565;
@@ -399,7 +402,7 @@ mod sealed {
         }
         #[inline(always)]
         fn memo(&self, k: Option<usize>, last: i32) -> Option<Remembered<'_>> {
-            // Keys are 24 bits: a triangle beyond is not cached.
+            // Keys are 20 bits (`INDEX`): a triangle beyond is not cached.
             let k = u32::try_from(k?).ok().filter(|&k| k <= INDEX)?;
             Some(Remembered {
                 cache: self.cache,
