@@ -669,7 +669,7 @@ impl Walk {
 /// line on the Cortex-M4, where inlined into the row walk its values did not fit the registers (three reloads from
 /// the stack per pixel); walked by `split_first_mut`, whose loop LLVM sets up for fewer instructions than the slice
 /// iterator's. Measured on the M4: 1.9% fewer instructions on W4 and 1.2% on W3 than inline with the iterator.
-/// Inlined on the M0 and RV32, where the call measured 1.3% to 2.1% more (the walk by `split_first_mut` is within
+/// Inlined on the M0 and RV32, where the call measured 0.8% to 2.1% more (the walk by `split_first_mut` is within
 /// 0.5% of the iterator's there, either way).
 #[cfg_attr(all(target_arch = "arm", target_has_atomic = "32"), inline(never))]
 #[cfg_attr(
