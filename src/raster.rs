@@ -379,6 +379,16 @@ impl<R: SpanRecip> Rasterizer<R> {
         }
     }
 
+    /// What a memo draw computes of `s` when nothing remembered stands in for it: the depth grid, and on the fast
+    /// tier the depth-grid values off the snap grid.
+    #[inline(always)]
+    fn depth_values<V: VertexInput>(&self, s: &mut Setup, v: &[V; 3]) {
+        Self::depth_grid(s, v);
+        if R::FAST_W16 && !s.on_grid {
+            s.fast_t = self.fast_t(s);
+        }
+    }
+
     /// [`Rasterizer::draw`], with `memo` keeping the fast tier's depth-grid values ([`t_at_snapped`]) across the
     /// bands of a frame (the mesh's [`crate::mesh::PlaneCache`]); the values are a function of the triangle alone, so
     /// a remembered one draws exactly what a computed one does.
@@ -437,12 +447,7 @@ impl<R: SpanRecip> Rasterizer<R> {
                     Some(Remember::T(Some(t))) => s.fast_t = Some(t),
                     // Declined there (a steep plane): the general set-up solves it from the depth grid.
                     Some(Remember::T(None)) => Self::depth_grid(&mut s, v),
-                    None => {
-                        Self::depth_grid(&mut s, v);
-                        if R::FAST_W16 && !s.on_grid {
-                            s.fast_t = self.fast_t(&s);
-                        }
-                    }
+                    None => self.depth_values(&mut s, v),
                 }
             } else {
                 Self::round_t(&mut s, te);
@@ -504,10 +509,7 @@ impl<R: SpanRecip> Rasterizer<R> {
             // Remembered for the small-triangle path, which did not draw it here (its conditions changed): the
             // values the general set-up reads.
             Self::round_t(&mut s, te);
-            Self::depth_grid(&mut s, v);
-            if R::FAST_W16 && !s.on_grid {
-                s.fast_t = self.fast_t(&s);
-            }
+            self.depth_values(&mut s, v);
         }
         let (mut w, solved) =
             match self.prepare_memo(&s, (depth.y0(), depth.height()), R::FAST_W16, solved)? {

@@ -170,23 +170,16 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool, const KEEP: bool>(
     let cy = ((j0 - oy) << SUBPIXEL_BITS) + 128;
     let (mut e, mut ex, mut ey) = ([0i32; 3], [0i32; 3], [0i32; 3]);
     // Without `KEEP` no band keeps anything (a constant: the branch is not compiled).
-    let (walk, keep) = match kept.take().filter(|_| KEEP) {
-        Some(_) if j0 > j1 => return Ok(Some(Stats::default())),
+    let remembered = kept.take().filter(|_| KEEP);
+    // No row in the buffer: nothing to draw (the general path would find none either).
+    if j0 > j1 {
+        return Ok(Some(Stats::default()));
+    }
+    let (walk, keep) = match remembered {
         Some(k) => {
             if !DIV {
-                for (i, (e, (ex, ey))) in e
-                    .iter_mut()
-                    .zip(ex.iter_mut().zip(ey.iter_mut()))
-                    .enumerate()
-                {
-                    let (a, c) = (q[i], q[(i + 1) % 3]);
-                    let (ea, eb) = (a.1 - c.1, c.0 - a.0);
-                    let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0))); // 0 on a top or left edge
-                    (*e, *ex, *ey) = (
-                        ea * (128 - a.0) + eb * (cy - a.1) - bias,
-                        ea << SUBPIXEL_BITS,
-                        eb << SUBPIXEL_BITS,
-                    );
+                for i in 0..3 {
+                    (_, e[i], ex[i], ey[i]) = edge_at(&q, i, cy);
                 }
             }
             let (kn, _) = code_factor(area2);
@@ -204,8 +197,6 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool, const KEEP: bool>(
             };
             (walk, (j_last > j1).then_some(k))
         }
-        // No row in the buffer: nothing to draw (the general path would find none either).
-        None if j0 > j1 => return Ok(Some(Stats::default())),
         None => {
             let Some((walk, keep)) = constants::<KEEP>(
                 s,
@@ -249,6 +240,18 @@ std::thread_local! {
     /// thread (the memo's tests count what it saves).
     pub(crate) static SMALL_CONSTANTS: core::cell::RefCell<std::vec::Vec<[(i32, i32); 3]>> =
         const { core::cell::RefCell::new(std::vec::Vec::new()) };
+}
+
+/// Edge `k -> k+1` of the oriented triangle `q` (relative to the box's origin pixel) at the centre of the origin
+/// column on the row whose centre is `cy` sub-pixels below the origin: its edge function `E` (`|E| < 2^28`, the
+/// module doc), `E` less its top-left bias (0 on a top or left edge, else 1), and its steps a column and a row.
+#[inline(always)]
+fn edge_at(q: &[(i32, i32); 3], k: usize, cy: i32) -> (i32, i32, i32, i32) {
+    let (a, c) = (q[k], q[(k + 1) % 3]);
+    let (ea, eb) = (a.1 - c.1, c.0 - a.0);
+    let er = ea * (128 - a.0) + eb * (cy - a.1);
+    let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0)));
+    (er, er - bias, ea << SUBPIXEL_BITS, eb << SUBPIXEL_BITS)
 }
 
 /// `K = 65535 2A = kn 2^kz` for the doubled area `area2` (below `2^29`: the box is under 32 x 126 px), `kn` in
@@ -324,11 +327,8 @@ fn constants<const KEEP: bool>(
     #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
     let mut er_m0 = [0i32; 3];
     for k in 0..3 {
-        let (a, c) = (q[k], q[(k + 1) % 3]);
-        let (ea, eb) = (a.1 - c.1, c.0 - a.0);
-        let er = ea * (128 - a.0) + eb * (cy - a.1); // |E| < 2^28 (module doc)
-        let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0))); // 0 on a top or left edge
-        (e[k], ex[k], ey[k]) = (er - bias, ea << SUBPIXEL_BITS, eb << SUBPIXEL_BITS);
+        let er;
+        (er, e[k], ex[k], ey[k]) = edge_at(q, k, cy);
         #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
         {
             er_m0[k] = er;
