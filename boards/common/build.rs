@@ -106,7 +106,8 @@ fn plans() {
         .unwrap_or_default();
     let mut s = String::new();
     let mut calls = String::new();
-    let (mut ram, mut rows, mut torus) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut ram, mut rows, mut torus, mut banded) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (k, f) in files.iter().enumerate() {
         let path = std::fs::canonicalize(f).unwrap_or_else(|e| panic!("PLAN file {f}: {e}"));
         println!("cargo:rerun-if-changed={}", path.display());
@@ -119,12 +120,15 @@ fn plans() {
         .unwrap();
         writeln!(
             calls,
-            "    ok &= crate::run_plan_line::<p{k}::PlanFormat, p{k}::PlanStrategy, C, {{ p{k}::PLAN_KIND }}, {{ p{k}::PLAN_SCENE }}>(board, core, &p{k}::PLAN, color, depth, verts, bins, counter, &mut *print);"
+            "    ok &= crate::run_plan_line::<p{k}::PlanFormat, p{k}::PlanStrategy, C, {{ p{k}::PLAN_KIND }}, {{ p{k}::PLAN_SCENE }}>(board, core, &p{k}::PLAN, color, depth, verts, bins, cache, counter, &mut *print);"
         )
         .unwrap();
         ram.push(format!("p{k}::PLAN.depth_ram"));
         rows.push(format!("if p{k}::PLAN_KIND == crate::NO_DEPTH {{ 0 }} else {{ p{k}::PLAN.band_rows as usize }}"));
         torus.push(format!("p{k}::PLAN_SCENE == crate::TORUS_SCENE"));
+        banded.push(format!(
+            "(p{k}::PLAN_KIND == crate::LEAN_W16 && p{k}::PLAN.band_rows < crate::HEIGHT)"
+        ));
     }
     let max = |v: &[String]| {
         v.iter()
@@ -156,7 +160,13 @@ fn plans() {
     .unwrap();
     writeln!(
         s,
-        "/// Runs every plan, printing its `bench` line; `false` when one failed.\n#[allow(unused_variables, unused_mut, clippy::let_and_return, clippy::too_many_arguments)]\npub fn run_all_plans<C: crate::Counter>(board: &str, core: &str, color: &mut [u16], depth: &mut [u16], verts: &mut [wraster::mesh::Projected], bins: &mut [u8], counter: &mut C, print: &mut dyn FnMut(core::fmt::Arguments<'_>)) -> bool {{\n    let mut ok = true;\n{calls}    ok\n}}"
+        "/// Whether a plan draws W16 in more than one band (with a plane cache, as the default build).\npub const BANDED: bool = false{};\n/// The plans' plane cache: [`crate::PLAN_TORUS_CACHE`] where a plan draws the torus (its vertices take the RAM),\n/// else the standard scenes' [`crate::SCENE_CACHE`]; none where no plan draws in bands.\npub const CACHE_LEN: usize = if !BANDED {{ 0 }} else if HAS_TORUS {{ crate::PLAN_TORUS_CACHE }} else {{ crate::SCENE_CACHE }};\n/// The plans' plane cache.\npub type PlanCache = wraster::mesh::PlaneCache<CACHE_LEN>;",
+        banded.iter().map(|t| format!(" || {t}")).collect::<String>()
+    )
+    .unwrap();
+    writeln!(
+        s,
+        "/// Runs every plan, printing its `bench` line; `false` when one failed.\n#[allow(unused_variables, unused_mut, clippy::let_and_return, clippy::too_many_arguments)]\npub fn run_all_plans<C: crate::Counter>(board: &str, core: &str, color: &mut [u16], depth: &mut [u16], verts: &mut [wraster::mesh::Projected], bins: &mut [u8], cache: &mut PlanCache, counter: &mut C, print: &mut dyn FnMut(core::fmt::Arguments<'_>)) -> bool {{\n    let mut ok = true;\n{calls}    ok\n}}"
     )
     .unwrap();
     let out = std::path::PathBuf::from(std::env::var("OUT_DIR").unwrap()).join("plans.rs");

@@ -329,10 +329,27 @@ pub fn run_scene_cached<R: SpanRecip, C: Counter>(
     bound: &mut [u16],
     cache: &mut impl SceneFrames,
     counter: &mut C,
+    on_band: impl FnMut(u16, &[u16]),
+) -> Result<Run, Error> {
+    let state = RenderState::new(scene.near, scene.far)?;
+    run_scene_in::<R, C>(scene, state, color, depth, bound, cache, counter, on_band)
+}
+
+/// [`run_scene_cached`] with the render state `state` (a plan's depth range), in bands of `depth.len() / WIDTH`
+/// rows.
+#[allow(clippy::too_many_arguments)]
+fn run_scene_in<R: SpanRecip, C: Counter>(
+    scene: &SceneData,
+    state: RenderState,
+    color: &mut [u16],
+    depth: &mut [u16],
+    bound: &mut [u16],
+    cache: &mut impl SceneFrames,
+    counter: &mut C,
     mut on_band: impl FnMut(u16, &[u16]),
 ) -> Result<Run, Error> {
     let band_h = (depth.len() / WIDTH as usize) as u16;
-    let mut r = Rasterizer::<R>::new(RenderState::new(scene.near, scene.far)?);
+    let mut r = Rasterizer::<R>::new(state);
     let frame = cache.frame(scene.tris);
     let mut stats = Stats::default();
     let (mut instructions, mut hash, mut bands) = (0u64, Fnv::default(), 0u32);
@@ -531,10 +548,13 @@ pub fn run_plan<
     depth: &mut [u16],
     verts: &mut [Projected],
     bins: &mut [u8],
+    cache: &mut (impl SceneFrames + TorusFrames),
     counter: &mut C,
 ) -> Result<Run, Error> {
     let mut stats = Stats::default();
     let mut hash = Fnv::default();
+    // W16 in more than one band: the mesh or list frame with the board's plane cache, as the default build draws.
+    let banded = KIND == LEAN_W16 && plan.band_rows < HEIGHT;
     if SCENE == TORUS_SCENE {
         use wraster::scenes::torus;
         let cam = torus::camera()?;
@@ -552,7 +572,7 @@ pub fn run_plan<
             let m = cam.model_matrix(&torus::model(k));
             counter.start();
             // W16 in more than one band: binned by rows as `run_torus` does, when the board gives the bins.
-            let binned = KIND == LEAN_W16 && plan.band_rows < HEIGHT && !bins.is_empty();
+            let binned = banded && !bins.is_empty();
             let frame = r.transform_mesh(&mesh, &m, &vp, verts).and_then(|f| {
                 if binned {
                     r.bin_mesh(f, &mut *bins)
@@ -567,18 +587,34 @@ pub fn run_plan<
                 // if the plan keeps one, after the band.
                 let n = WIDTH as usize * plan.band_rows as usize;
                 let (depth, rest) = split_depth(depth, n)?;
-                mesh_frame_in_bands(
-                    &mut r,
-                    &frame,
-                    plan.band_rows,
-                    color,
-                    depth,
-                    if plan.coarse { rest } else { &mut [] },
-                    counter,
-                    &mut stats,
-                    &mut hash,
-                    &mut |_, _| {},
-                )?
+                let bound = if plan.coarse { rest } else { &mut [] };
+                if banded {
+                    mesh_frame_in_bands(
+                        &mut r,
+                        &cache.attach(frame),
+                        plan.band_rows,
+                        color,
+                        depth,
+                        bound,
+                        counter,
+                        &mut stats,
+                        &mut hash,
+                        &mut |_, _| {},
+                    )?
+                } else {
+                    mesh_frame_in_bands(
+                        &mut r,
+                        &frame,
+                        plan.band_rows,
+                        color,
+                        depth,
+                        bound,
+                        counter,
+                        &mut stats,
+                        &mut hash,
+                        &mut |_, _| {},
+                    )?
+                }
             } else {
                 let v = frame.vertices();
                 run_planned_tris::<F, R, C, KIND>(
@@ -629,6 +665,13 @@ pub fn run_plan<
     let scene = SCENES.get(SCENE).ok_or(Error::IndexOutOfRange)?;
     let mut state = RenderState::new(scene.near, scene.far)?;
     state.range = wraster::DepthRange::new(plan.near, plan.far)?;
+    if banded {
+        // The list frame with the plane cache, as the default build (the same pixels, codes and hash as the
+        // triangles drawn one by one below).
+        let (depth, rest) = split_depth(depth, WIDTH as usize * plan.band_rows as usize)?;
+        let bound = if plan.coarse { rest } else { &mut [] };
+        return run_scene_in::<R, C>(scene, state, color, depth, bound, cache, counter, |_, _| {});
+    }
     let (instructions, bands) = run_planned_tris::<F, R, C, KIND>(
         // Only the triangles whose rows meet the band's, checked before their vertices are made (as `run_scene`
         // does).
@@ -662,7 +705,10 @@ pub fn run_plan<
 
 /// [`run_plan`] and its `bench` line, with `format=` the plan's and the added keys `plan=1 depth_ram=..
 /// visibility_errors=..` (and `frames=8 instr_per_frame=` for the torus), or an `error` line; `false` on an error.
+/// Out of line: one plan's run at a time on the stack (a firmware of several plans overflowed the Cortex-M0's stack
+/// into its statics when they were inlined into one frame).
 #[allow(clippy::too_many_arguments)]
+#[inline(never)]
 pub fn run_plan_line<
     F: Codec<Word: bytemuck::Pod>,
     R: SpanRecip,
@@ -677,10 +723,11 @@ pub fn run_plan_line<
     depth: &mut [u16],
     verts: &mut [Projected],
     bins: &mut [u8],
+    cache: &mut (impl SceneFrames + TorusFrames),
     counter: &mut C,
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
-    match run_plan::<F, R, C, KIND, SCENE>(plan, color, depth, verts, bins, counter) {
+    match run_plan::<F, R, C, KIND, SCENE>(plan, color, depth, verts, bins, cache, counter) {
         Ok(run) => {
             // The bench line with the plan's format.
             let mut line = bench_line_of(board, core, plan.format, &run);
@@ -773,6 +820,9 @@ pub fn run_all_cached<R: SpanRecip, C: Counter>(
 /// leave (with 300 bytes of stack to spare). The M0's W4 firmware given more RAM (its `memory.x` at 64K, run in
 /// QEMU's mps2-an386) saved 4.4%, 6.8%, 8.6%, 10.4% and 11.1% of the frame's instructions with 16, 24, 32, 48 and 96.
 pub const TORUS_CACHE: usize = 25;
+/// The W4 plane cache of a plan's firmware (`--features plan`): the plans' runner is deeper on the stack than the
+/// default build's W4 run, and on the Cortex-M0 22 triangles keep its 256 bytes free (25 left 204).
+pub const PLAN_TORUS_CACHE: usize = 22;
 /// A board's W4 plane cache.
 pub type TorusCache = wraster::mesh::PlaneCache<TORUS_CACHE>;
 

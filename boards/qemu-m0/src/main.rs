@@ -268,6 +268,8 @@ fn main() -> ! {
         rhw: 0.0,
     }; VERTS_LEN];
     static mut BINS: [u8; BINS_LEN] = [0; BINS_LEN];
+    // The plane cache of plans drawn in bands (as the default build's; empty where none is).
+    static mut CACHE: wraster_board::plans::PlanCache = wraster_board::plans::PlanCache::new();
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
     let ok = plans::run_all_plans(
@@ -277,6 +279,7 @@ fn main() -> ! {
         wraster_board::u16_words(DEPTH),
         VERTS,
         BINS,
+        CACHE,
         &mut counter,
         &mut |a| hprintln!("{}", a),
     );
