@@ -282,12 +282,55 @@ fn smul_hi(a: i32, b: i32) -> i32 {
 )]
 #[inline(always)]
 fn mul_hi_halves(a: u32, b: u32) -> u32 {
-    let (ah, al, bh, bl) = (a >> 16, a & 0xffff, b >> 16, b & 0xffff);
     // LLVM recognises the whole sum as the high word of a 64-bit product and calls the library for it again; an
-    // opaque value (no instruction of its own) keeps the four products.
-    let (lh, hl) = (core::hint::black_box(al) * bh, ah * bl);
+    // opaque low half keeps the four products (on the M0 it costs a store and a load: [`HiFactor`] takes a loop's
+    // constant factor out of the loop).
+    halves_hi(a >> 16, core::hint::black_box(a & 0xffff), b)
+}
+
+/// [`mul_hi_halves`] from the halves `ah`, `al` of `a`.
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn halves_hi(ah: u32, al: u32, b: u32) -> u32 {
+    let (bh, bl) = (b >> 16, b & 0xffff);
+    let (lh, hl) = (al * bh, ah * bl);
     let mid = ((al * bl) >> 16) + (lh & 0xffff) + (hl & 0xffff);
     (ah * bh) + (lh >> 16) + (hl >> 16) + (mid >> 16)
+}
+
+/// A factor of many [`mul_hi`] products (a loop's constant), prepared once before the loop: on the Cortex-M0 its
+/// 16-bit halves, made opaque to LLVM here ([`mul_hi_halves`]) rather than in every product, where that cost a
+/// store and a load each time. The same bits as [`mul_hi`] on every core.
+#[derive(Clone, Copy)]
+pub(crate) struct HiFactor {
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    halves: (u32, u32),
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    a: u32,
+}
+
+impl HiFactor {
+    /// The factor `a`.
+    #[inline(always)]
+    pub(crate) fn new(a: u32) -> Self {
+        #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+        return HiFactor {
+            halves: core::hint::black_box((a >> 16, a & 0xffff)),
+        };
+        #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+        return HiFactor { a };
+    }
+    /// The high word of `a b` (as [`mul_hi`]).
+    #[inline(always)]
+    pub(crate) fn mul_hi(self, b: u32) -> u32 {
+        #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+        return halves_hi(self.halves.0, self.halves.1, b);
+        #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+        return mul_hi(self.a, b);
+    }
 }
 
 /// The signed high word from the unsigned one: `a b = ua ub - 2^32 (b [a < 0] + a [b < 0])` modulo `2^64`.

@@ -60,7 +60,7 @@ use crate::edge::{flat_rows, Edge, Fixed, Side, Sub};
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
 use crate::fast::{
-    bits64 as bits, fresh61, lz_small, mul_hi, mul_wide, shl64, shr64, smul_wide, wmul, FreshSeed,
+    bits64 as bits, fresh61, lz_small, mul_wide, shl64, shr64, smul_wide, wmul, FreshSeed, HiFactor,
 };
 use crate::setup::{rows_of, Setup, Stats, SUBPIXEL_BITS};
 use crate::state::{Cull, RenderState};
@@ -608,6 +608,7 @@ impl Walk {
         let mut stats = Stats::default();
         let width = depth.width() as i32;
         let sc0 = s0.wrapping_sub(lz0 + 1);
+        let kn = HiFactor::new(kn);
         // The rows are in the buffer (`j0 >= y0`, `j1` below its last row): row `j` starts at `(j - y0) width`, walked
         // by adding the width (no multiply and no overflow checks per row) where the core has the registers for it
         // (measured: 1.2% fewer instructions on the M4's W3, 3.3% more on the M0's, which takes the row by index).
@@ -680,7 +681,7 @@ fn depth_run<S: FreshSeed, const SAME_LZ: bool>(
     row: &mut [u16],
     mut v: u64,
     sx: u64,
-    kn: u32,
+    kn: HiFactor,
     s0: u32,
     sc0: u32,
 ) -> u32 {
@@ -695,7 +696,7 @@ fn depth_run<S: FreshSeed, const SAME_LZ: bool>(
             let lz = lz_small(h);
             ((h << lz) | ((v as u32) >> (32 - lz)), s0 - lz - 1)
         };
-        let hi = mul_hi(kn, fresh61::<S>(m) as u32);
+        let hi = kn.mul_hi(fresh61::<S>(m) as u32);
         // Below 2^16 (the module doc), compared as u32.
         let c = ((hi >> sc) + 1) >> 1;
         let ok = c < *stored as u32;
@@ -772,10 +773,27 @@ fn s_by_differences(
     (sr, sx, sy, (s_max, s_min))
 }
 
-/// `x k` (wrapping) for a small `k`, without a 64-bit multiply (a library call on the Cortex-M0).
+/// `x k` (wrapping) for `k < 2^15` (a row or column offset inside a small triangle's box), without a 64-bit multiply
+/// (a library call on the Cortex-M0). There the low word's carry takes two 16-bit products instead of
+/// [`mul_wide`]'s four: with `x_lo = h 2^16 + l`, `x_lo k = h k 2^16 + l k` (each below `2^31`), so its high word is
+/// `floor((h k + floor(l k / 2^16)) / 2^16)` (floors of floors; the sum is below `2^32`). Measured on the M0, with
+/// [`HiFactor`]: 2.2% fewer instructions on W3 and 1.6% on W4. The M4 takes the carry from [`mul_wide`] (one
+/// `UMULL`; the two products measured 1.6% more on W3) and adds it to the high word (0.3% fewer on W4 than the 64-bit
+/// sum, which RV32 keeps: 0.1% fewer there).
 #[inline(always)]
 fn mul_small(x: u64, k: u32) -> u64 {
-    mul_wide(x as u32, k).wrapping_add((((x >> 32) as u32).wrapping_mul(k) as u64) << 32)
+    debug_assert!(k < 1 << 15);
+    let (lo, hi) = (x as u32, ((x >> 32) as u32).wrapping_mul(k));
+    if cfg!(target_arch = "arm") {
+        let carry = if cfg!(target_has_atomic = "32") {
+            (mul_wide(lo, k) >> 32) as u32
+        } else {
+            ((lo >> 16) * k + (((lo & 0xffff) * k) >> 16)) >> 16
+        };
+        (hi.wrapping_add(carry) as u64) << 32 | lo.wrapping_mul(k) as u64
+    } else {
+        mul_wide(lo, k).wrapping_add((hi as u64) << 32)
+    }
 }
 
 /// One row's `len` pixels from column `x` to the target, as one `fill_solid`.
