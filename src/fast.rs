@@ -173,8 +173,27 @@ impl FreshSeed for Chord {
 /// [`Chord`]'s seed `x0`, near `2^48 / m` (within `2^-15.9`).
 #[inline(always)]
 fn chord_seed(m: u32) -> u32 {
-    const T: [u32; CELLS] = seed_table();
-    let w = T[((m >> 23) & 255) as usize];
+    // `m >= 2^31`, so the cell is `(m >> 23) - 256`. The Cortex-M0 indexes a table twice as long, whose first half is
+    // never read, by `m >> 23` alone: the mask `& 255` is a constant it has no immediate for (two instructions a
+    // pixel, and a register; measured: W1 -3.0%, W2 -1.4%, for 1 KiB of flash). Other cores extract the field in one.
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    let w = {
+        const T: [u32; 2 * CELLS] = {
+            let (mut t, s) = ([0u32; 2 * CELLS], seed_table());
+            let mut k = 0;
+            while k < CELLS {
+                t[CELLS + k] = s[k];
+                k += 1;
+            }
+            t
+        };
+        T[(m >> 23) as usize]
+    };
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    let w = {
+        const T: [u32; CELLS] = seed_table();
+        T[((m >> 23) & 255) as usize]
+    };
     let u = (m << 9) >> 21;
     ((w >> 11) - (((w & 2047) * u) >> 10)) >> 3
 }
