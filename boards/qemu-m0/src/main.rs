@@ -4,7 +4,7 @@
 //! a 320x8 W16 band, 10 KiB), triangles binned by rows (see `wraster-board`), with the default reciprocal and with the previous-pixel seed, prints one `bench` line per
 //! run over semihosting and exits 0; any error or panic exits non-zero. `--features torus` builds W4 instead (the
 //! rotating torus through the mesh path, 60 bands of 4 rows: its 512 transformed vertices take 6 KiB of the 16, its
-//! row bins 1 KiB, its plane cache 724 bytes, and the deepest stack of the run, 3.0 KiB, leaves 380 bytes free:
+//! row bins 1 KiB, its plane cache 780 bytes, and the deepest stack of the run, 3.0 KiB, leaves 268 bytes free:
 //! `boards/tools/stackdepth.c`, which CI runs on this build and fails under 256).
 //! Run: `cd boards/qemu-m0 && cargo run --release` (the runner in `.cargo/config.toml` adds `-icount shift=0`).
 //!
@@ -25,7 +25,7 @@ use wraster::recip::SpanRecip;
 #[cfg(not(any(feature = "size-probe", feature = "plan")))]
 use wraster::recip::{Exact, FastDiv, PrevPixel};
 #[cfg(not(feature = "torus"))]
-use wraster_board::{run_all_cached, SceneCache};
+use wraster_board::run_all_cached;
 #[cfg(not(any(feature = "size-probe", feature = "torus")))]
 use wraster_board::{run_scene_cached, SCENES};
 use wraster_board::{SysTick, HEIGHT, WIDTH};
@@ -43,6 +43,21 @@ const BAND_ROWS: usize = 8;
 const BAND_ROWS: usize = 4;
 const PIXELS: usize = WIDTH as usize * BAND_ROWS;
 const _: () = assert!((HEIGHT as usize).is_multiple_of(BAND_ROWS));
+
+/// The standard scenes' plane cache on this board: 84 triangles (2,376 bytes) leave the deepest stack 276 bytes free
+/// (CI fails under 256), and hold W3's triangles across a band's edge (64, the other boards' `SCENE_CACHE`, did not:
+/// W3 0.9% and the terrain 1.9% more instructions). 54 with `--features coarse`, whose bound takes 640 bytes and
+/// whose runs go deeper: 304 bytes free (with 64, as before, 16).
+#[cfg(not(feature = "torus"))]
+type SceneCache = wraster::mesh::PlaneCache<
+    {
+        if cfg!(feature = "coarse") {
+            54
+        } else {
+            84
+        }
+    },
+>;
 
 #[cfg(not(feature = "torus"))]
 fn all<R: SpanRecip>(
@@ -131,7 +146,7 @@ fn main() -> ! {
     // The row bins (`Rasterizer::bin_mesh`, a byte per triangle): each of the 60 bands sets up only the triangles
     // that can reach it.
     static mut BINS: [u8; TRIANGLES] = [0; TRIANGLES];
-    // The plane cache (`wraster::mesh::PlaneCache`, 25 triangles, 724 bytes): a triangle reaching several bands has
+    // The plane cache (`wraster::mesh::PlaneCache`, 27 triangles, 780 bytes): a triangle reaching several bands has
     // its depth-grid values computed once a frame, not in each band. 22 in the `cull` build, which LLVM inlines
     // differently: the stack keeps 256 bytes free in both.
     static mut CACHE: Cache = Cache::new();
@@ -192,8 +207,8 @@ fn main() -> ! {
 fn main() -> ! {
     static mut COLOR: [u16; PIXELS] = [0; PIXELS];
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
-    // The plane cache of the standard scenes (`wraster::mesh::PlaneCache`, `wraster_board::SCENE_CACHE`
-    // triangles): a triangle reaching several bands is set up once a frame where it has room.
+    // The plane cache of the standard scenes (`wraster::mesh::PlaneCache`, `SceneCache` above): a triangle reaching
+    // several bands is set up once a frame where it has room.
     static mut CACHE: SceneCache = SceneCache::new();
     // The coarse bound of `--features coarse`: one code per 8 pixels of each band row (640 bytes).
     #[cfg(feature = "coarse")]
