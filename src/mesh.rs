@@ -463,7 +463,7 @@ impl Cache<'_> {
         if st.band_end.get() == y0 && st.tag.get() == tag && !self.slots.is_empty() {
             // Entries the previous band left unread: their triangles did not come back.
             let p = st.prev.get();
-            st.head.set((st.head.get() + p) % self.slots.len());
+            st.head.set(wrap(st.head.get() + p, self.slots.len()));
             st.len.set(st.len.get() - p);
         } else {
             st.head.set(0);
@@ -547,7 +547,7 @@ impl Cache<'_> {
         let (st, n) = (self.state, self.slots.len());
         let len = st.len.get();
         if len < n {
-            let at = (st.head.get() + len) % n;
+            let at = wrap(st.head.get() + len, n);
             let (key, t) = match r {
                 // `s0 <= 32` and `lz <= 8` (`crate::small`'s module doc); a value beyond the key's bits is not kept.
                 Remember::Small(Kept { shifts, .. })
@@ -1356,6 +1356,17 @@ impl Sphere {
     }
 }
 
+/// `i % n` for `i < 2 n` (a ring index: the head and a length, each below `n`), without the division (a library
+/// call on the Cortex-M0, where a band's cache keeps its triangles in the ring).
+#[inline(always)]
+fn wrap(i: usize, n: usize) -> usize {
+    debug_assert!(i < 2 * n.max(1));
+    if i >= n {
+        i - n
+    } else {
+        i
+    }
+}
 #[cfg(test)]
 mod tests {
     use super::*;
