@@ -217,15 +217,17 @@ fn main() -> ! {
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
     let ok = all::<Fast>(COLOR, DEPTH, CACHE, &mut counter);
-    // `--features coarse`: the default again with a coarse depth bound (`bound=coarse` lines), same hashes.
+    // `--features coarse`: the default again with a coarse depth bound (`bound=coarse` lines), same hashes; drawn
+    // the same way (list frames with the plane cache), so the two lines differ by the bound alone.
     #[cfg(feature = "coarse")]
     let ok = ok
-        & wraster_board::run_all_bounded::<Fast, _>(
+        & run_all_cached::<Fast, _>(
             "qemu-m0",
             "m0",
             COLOR,
             DEPTH,
             BOUND,
+            CACHE,
             &mut counter,
             |line| hprintln!("{}", line),
         );
