@@ -147,11 +147,12 @@ struct Bins<'a> {
 ///
 /// A frame drawn in bands sets a triangle up again in every band it reaches; on the fast tier the costliest part of
 /// that set-up for vertices off the 1/256 px grid is the depth-grid correction (the plane through the vertices as
-/// given, evaluated at the snapped ones: about 1,690 instructions a triangle on the Cortex-M0, a fifth of W4's
-/// frame there). The cache keeps those values for the triangles that reach the next band, so each is computed
-/// once a frame; for a triangle too large for the small-triangle path it keeps the solved plane of `T` instead (the
-/// exact solve, three 128-bit divisions), and for a small triangle that path drew, its depth constants (the next
-/// band skips the range tests, the products of its depth sum and their leading zeros). All are functions of the
+/// given, evaluated at the snapped ones: about 1,580 instructions a triangle on the Cortex-M0, where without a cache
+/// it would be about a fifth of W4's frame). The cache keeps those values for the triangles that reach the next
+/// band, so each is computed once a frame; for a triangle too large for the small-triangle path it keeps the solved
+/// plane of `T` instead (the exact solve, three 128-bit divisions), and for a small triangle that path drew, its
+/// depth constants (the next band skips the range tests, the products of its depth sum and their leading zeros).
+/// All are functions of the
 /// triangle alone, so the frames are the same with and without the cache; a full cache just computes the values
 /// again. Triangle lists use it too ([`PlaneCache::list`]). Bands must come in order, top to bottom, for it to help:
 /// a band that does not start where the previous one ended, a change of the depth range or of the strategy empties
