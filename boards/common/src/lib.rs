@@ -588,32 +588,27 @@ pub fn run_plan<
                 let n = WIDTH as usize * plan.band_rows as usize;
                 let (depth, rest) = split_depth(depth, n)?;
                 let bound = if plan.coarse { rest } else { &mut [] };
+                // The frame cached or as it is: two types, one call each.
+                macro_rules! in_bands {
+                    ($frame:expr) => {
+                        mesh_frame_in_bands(
+                            &mut r,
+                            $frame,
+                            plan.band_rows,
+                            color,
+                            depth,
+                            bound,
+                            counter,
+                            &mut stats,
+                            &mut hash,
+                            &mut |_, _| {},
+                        )?
+                    };
+                }
                 if banded {
-                    mesh_frame_in_bands(
-                        &mut r,
-                        &cache.attach(frame),
-                        plan.band_rows,
-                        color,
-                        depth,
-                        bound,
-                        counter,
-                        &mut stats,
-                        &mut hash,
-                        &mut |_, _| {},
-                    )?
+                    in_bands!(&cache.attach(frame))
                 } else {
-                    mesh_frame_in_bands(
-                        &mut r,
-                        &frame,
-                        plan.band_rows,
-                        color,
-                        depth,
-                        bound,
-                        counter,
-                        &mut stats,
-                        &mut hash,
-                        &mut |_, _| {},
-                    )?
+                    in_bands!(&frame)
                 }
             } else {
                 let v = frame.vertices();
