@@ -152,9 +152,8 @@ struct Bins<'a> {
 /// band, so each is computed once a frame; for a triangle too large for the small-triangle path it keeps the solved
 /// plane of `T` instead (the exact solve, three 128-bit divisions), and for a small triangle that path drew, its
 /// depth constants (the next band skips the range tests, the products of its depth sum and their leading zeros).
-/// All are functions of the
-/// triangle alone, so the frames are the same with and without the cache; a full cache just computes the values
-/// again. Triangle lists use it too ([`PlaneCache::list`]). Bands must come in order, top to bottom, for it to help:
+/// All are functions of the triangle alone, so the frames are the same with and without the cache; a full cache
+/// just computes the values again. Triangle lists use it too ([`PlaneCache::list`]). Bands must come in order, top to bottom, for it to help:
 /// a band that does not start where the previous one ended, a change of the depth range or of the strategy empties
 /// it. Triangles from index 2^20 on are not cached.
 ///
@@ -793,8 +792,8 @@ impl<'a, C: Copy> MeshFrame<'a, C> {
 /// Every band tests every byte, and most are out of reach: on the M0's 60 bands of W4 this scan was about 4% of the
 /// frame's instructions (3.6 million over the 8 frames of 89.7 million), so where no triangle is to clip and the
 /// reach is under 128 buckets (W4's is a few) it tests four bytes at a time ([`Reach`], [`skip_words`]) over the
-/// aligned words (measured: the M0's W4 frame 1.8% fewer instructions). Fewer would take a coarser index (a bucket range per group of triangles) or the triangles sorted by
-/// bucket (two bytes each).
+/// aligned words (measured: the M0's W4 frame 1.8% fewer instructions). Fewer would take a coarser index (a bucket
+/// range per group of triangles) or the triangles sorted by bucket (two bytes each).
 #[inline]
 fn next_in_reach(of: &[u8], mut k: usize, lo: u8, span: u8, clips: bool) -> usize {
     if !clips {
@@ -1430,6 +1429,7 @@ fn wrap(i: usize, n: usize) -> usize {
         i
     }
 }
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1450,17 +1450,11 @@ mod tests {
         }
     }
 
-    /// The bins of strips of small triangles whose tops run down 1.3 rows apart, every fifth one back-facing, every
-    /// seventh one with a vertex to clip: 300 from row -20 (a range of 390 rows: buckets of 2 rows), 150 from row 100
-    /// (193 rows: a bucket per row) and one alone. Each kept triangle's byte is the bucket of its top row
-    /// `(trunc(ymin) - 1 - origin) >> shift`, with `origin` the least top row and `shift` the least that brings the
-    /// range under 254 buckets; the culled and clipped ones carry their marks; rows beyond the range clamp to the first
-    /// and the last bucket.
     #[test]
     fn the_word_scan_finds_what_the_byte_scan_finds() {
-        // Every `lo`, every reach up to 127 (the words' limit) and past it, from every start, over bytes at every
-        // alignment (slices of a longer array), random and placed around the reach's edges: the first byte in reach
-        // found four at a time is the byte loop's.
+        // Every `lo`, reaches up to 127 (the words' limit) and past it, from starts at every alignment of the word
+        // (slices of a longer array at several offsets), over random bytes and bytes placed around the reach's edges:
+        // the first byte in reach found four at a time is the byte loop's.
         let mut rnd = crate::xorshift(0x5EED_B175);
         let buf: Vec<u8> = (0..300).map(|_| (rnd() >> 24) as u8).collect();
         let slow = |of: &[u8], mut k: usize, lo: u8, span: u8| {
@@ -1497,6 +1491,12 @@ mod tests {
         assert!(found > 10_000, "{found}");
     }
 
+    /// The bins of strips of small triangles whose tops run down 1.3 rows apart, every fifth one back-facing, every
+    /// seventh one with a vertex to clip: 300 from row -20 (a range of 390 rows: buckets of 2 rows), 150 from row 100
+    /// (193 rows: a bucket per row) and one alone. Each kept triangle's byte is the bucket of its top row
+    /// `(trunc(ymin) - 1 - origin) >> shift`, with `origin` the least top row and `shift` the least that brings the
+    /// range under 254 buckets; the culled and clipped ones carry their marks; rows beyond the range clamp to the first
+    /// and the last bucket.
     #[test]
     fn buckets_follow_the_top_rows() {
         for (start, n, want_shift) in [(-20.0f32, 300usize, 1u32), (100.0, 150, 0), (37.2, 1, 0)] {

@@ -812,7 +812,8 @@ pub fn run_all_cached<R: SpanRecip, C: Counter>(
 
 /// Triangles a board's W4 plane cache holds ([`wraster::mesh::PlaneCache`]): those that reach the next band, and the
 /// previous band's until the walk meets them; a full cache only computes values again. 27 is what the M0's 16 KiB
-/// leave (its deepest stack then keeps 268 bytes free, over CI's 256; 25 kept 324 and cost 1.1% more a frame). The M0's W4 firmware given more RAM (its `memory.x` at 64K, run in
+/// leave (its deepest stack then keeps 268 bytes free, over CI's 256; 25 kept 324 and cost 1.1% more a frame). The
+/// M0's W4 firmware given more RAM (its `memory.x` at 64K, run in
 /// QEMU's mps2-an386) saved 4.4%, 6.8%, 8.6%, 10.4% and 11.1% of the frame's instructions with 16, 24, 32, 48 and 96.
 pub const TORUS_CACHE: usize = 27;
 /// The W4 plane cache of a plan's firmware (`--features plan`): the plans' runner is deeper on the stack than the
