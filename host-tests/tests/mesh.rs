@@ -14,11 +14,11 @@
 //! as before this term existed, the test fails there). A pixel none of whose probes hits must stay empty.
 
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
-use host_tests::{hash_frame, render_torus, Frame};
+use host_tests::{hash_frame, in_bands, render_torus, Frame};
 use wraster::clip::Viewport;
 use wraster::mesh::{Colors, Mesh, Projected};
 use wraster::projection::{Camera, Mat4};
-use wraster::recip::{Exact, Fast, SpanRecip};
+use wraster::recip::{Exact, Fast, FastDiv, FastDivInt, SpanRecip};
 use wraster::scenes::{torus, HEIGHT, WIDTH};
 use wraster::{DepthBuffer, Error, Rasterizer, RenderState, W16_FAR};
 
@@ -217,6 +217,72 @@ fn torus_frames_match_the_f64_ray_caster_fast() {
 #[test]
 fn torus_frames_match_the_f64_ray_caster_exact() {
     check_frames::<Exact>();
+}
+
+#[test]
+fn torus_frames_match_the_f64_ray_caster_fast_div_int() {
+    check_frames::<FastDivInt>();
+}
+
+/// `FastDivInt` (for cores with a divider and no FPU) transforms as `Fast` (the integer transform: the same vertices,
+/// bit for bit) and draws as `FastDiv` (the same frame from the same vertices): W4's eight frames, in bands of 8 rows.
+/// Its vertices differ from `FastDiv`'s f32 transform somewhere (otherwise this would not tell the two apart).
+#[test]
+fn fast_div_int_transforms_as_fast_and_draws_as_fast_div() {
+    let (pos, idx, col) = (torus::positions(), torus::indices(), torus::colors());
+    let mesh = Mesh {
+        positions: &pos,
+        indices: &idx,
+        colors: Colors::PerFace(&col),
+    };
+    let cam = torus::camera().unwrap();
+    let state = cam.render_state().unwrap();
+    let vp = Viewport::new(0.0, 0.0, WIDTH as f32, HEIGHT as f32);
+    let bits = |v: &[Projected]| -> Vec<[u32; 3]> {
+        v.iter()
+            .map(|p| [p.x.to_bits(), p.y.to_bits(), p.rhw.to_bits()])
+            .collect()
+    };
+    let mut f32_differs = 0;
+    for k in 0..torus::FRAMES {
+        let m = cam.model_matrix(&torus::model(k));
+        let mut int_div = vec![Projected::default(); pos.len()];
+        let mut int_fast = vec![Projected::default(); pos.len()];
+        let mut f32_div = vec![Projected::default(); pos.len()];
+        let mut r = Rasterizer::<FastDivInt>::new(state);
+        let mut by_div = Rasterizer::<FastDiv>::new(state);
+        r.transform_mesh(&mesh, &m, &vp, &mut int_div).unwrap();
+        Rasterizer::<Fast>::new(state)
+            .transform_mesh(&mesh, &m, &vp, &mut int_fast)
+            .unwrap();
+        by_div.transform_mesh(&mesh, &m, &vp, &mut f32_div).unwrap();
+        assert_eq!(bits(&int_div), bits(&int_fast), "frame {k}");
+        f32_differs += bits(&int_div)
+            .iter()
+            .zip(bits(&f32_div))
+            .filter(|(a, b)| **a != *b)
+            .count();
+        let mut scratch = vec![Projected::default(); pos.len()];
+        let mf = r.transform_mesh(&mesh, &m, &vp, &mut scratch).unwrap();
+        let draw = |draw: &mut dyn FnMut(
+            &mut Frame,
+            &mut DepthBuffer<'_>,
+        ) -> Result<wraster::Stats, Error>| {
+            let mut frame = Frame::new(WIDTH as u32, HEIGHT as u32);
+            let mut depth = vec![0u16; WIDTH as usize * HEIGHT as usize];
+            let stats =
+                in_bands(&mut depth, WIDTH, HEIGHT, 8, |buf| draw(&mut frame, buf)).unwrap();
+            (frame, depth, stats.written)
+        };
+        let a = draw(&mut |f, buf| r.draw_mesh_frame(f, buf, &mf));
+        let b = draw(&mut |f, buf| by_div.draw_mesh_frame(f, buf, &mf));
+        assert!(a.0 == b.0 && a.1 == b.1 && a.2 == b.2, "frame {k}");
+        assert!(a.2 > 10_000, "frame {k}: {} pixels written", a.2);
+    }
+    assert!(
+        f32_differs > 0,
+        "the integer and f32 transforms gave the same vertices"
+    );
 }
 
 /// A frame drawn in bands (transformed once, binned by rows) equals the frame drawn whole, bit for bit.

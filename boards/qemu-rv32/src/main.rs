@@ -1,8 +1,8 @@
 //! wraster on QEMU `virt` (RV32IMAC, riscv32imac-unknown-none-elf), memory map in `memory.x`.
 //!
-//! Renders every standard scene whole-frame (320x240 colour and W16 depth in RAM), with the default reciprocal and
-//! with the previous-pixel seed, prints one `bench` line per run over semihosting and exits 0; any error or panic
-//! exits non-zero. Run: `cd boards/qemu-rv32 && cargo run --release`.
+//! Renders every standard scene (or, with `--features torus`, W4's torus) whole-frame (320x240 colour and W16 depth in
+//! RAM) with this core's default strategy, then the other cores' defaults and the other strategies, prints one `bench`
+//! line per run over semihosting and exits 0; any error or panic exits non-zero. Run: `cd boards/qemu-rv32 && cargo run --release`.
 //!
 //! Instructions are the difference of the `minstret` CSR (instructions retired) around the draw calls only: exact.
 #![no_std]
@@ -12,6 +12,8 @@
 use riscv_rt::entry;
 use riscv_semihosting::{debug, hprintln};
 use wraster::mesh::Projected;
+#[cfg(feature = "torus")]
+use wraster::recip::FastDivInt;
 use wraster::recip::{Exact, Fast, FastDiv, PrevPixel, SpanRecip};
 use wraster::scenes::torus::VERTICES;
 #[cfg(not(feature = "torus"))]
@@ -66,8 +68,15 @@ fn main() -> ! {
     // The frame lives on the stack (riscv-rt gives it the top of the 16 MiB RAM): no `static mut`, no unsafe.
     let (mut color, mut depth) = ([0u16; PIXELS], [0u16; PIXELS]);
     let mut verts = [Projected::default(); VERTICES];
-    // This core's default first (RV32IM has DIVU: the division-seeded fast tier), then the others for the hash test.
-    let ok = all::<FastDiv>(&mut color, &mut depth, &mut verts)
+    // This core's default first (RV32IM has DIVU and no FPU: the division-seeded fast tier, W4's meshes transformed in
+    // integers, `FastDivInt`; the standard scenes are given in screen space, where it is `FastDiv`), then the others
+    // for the hash test.
+    #[cfg(feature = "torus")]
+    let ok = all::<FastDivInt>(&mut color, &mut depth, &mut verts);
+    #[cfg(not(feature = "torus"))]
+    let ok = true;
+    let ok = ok
+        & all::<FastDiv>(&mut color, &mut depth, &mut verts)
         & all::<Fast>(&mut color, &mut depth, &mut verts)
         & all::<Exact>(&mut color, &mut depth, &mut verts)
         & all::<PrevPixel>(&mut color, &mut depth, &mut verts);
