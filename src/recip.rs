@@ -299,6 +299,7 @@ impl SpanRecip for Fast {
 /// `UDIV`, below `2^-15 (1 + 2^-14)`) instead of the 256-cell table and half-word step: fewer instructions a fresh
 /// pixel and no table in flash. Its frames differ from [`Fast`]'s in rare last-bit roundings, and are the same on
 /// every core (on the Cortex-M0, which has no divide instruction, the division is a library call: correct, slow).
+/// Meshes are transformed in f32 (the M4F's FPU); on a core without an FPU take [`FastDivInt`].
 #[derive(Default)]
 pub struct FastDiv;
 
