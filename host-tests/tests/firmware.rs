@@ -5,7 +5,7 @@
 //! little-endian). This test renders the same scenes here, whole-frame (the M0 board renders in 30 bands), hashes
 //! them with its own FNV-1a, and asserts every board's hash and pixel counts equal the host's. W4 (the torus, 8
 //! frames through the mesh path) has one hash over its 8 frames; each board runs it in a build of its own
-//! (`--features torus`).
+//! (`--features torus`), and RV32's default for it (`FastDivInt`) also in the M4's and M0's `--features cull` builds.
 //!
 //! The boards run under QEMU (`.ci/run` installs it). Without QEMU the test fails, unless `WRASTER_SKIP_FIRMWARE=1`
 //! says to skip it: a test that cannot run never reports "ok" by itself.
