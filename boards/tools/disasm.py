@@ -1,4 +1,4 @@
-"""The disassembly the board tools share (`profile.py`, `text_share.py`, `cycles.py`): llvm-objdump's listing of an
+"""The disassembly the board tools share (`profile.py`, `text_share.py`, `cycles.py`, `stackchain.py`): llvm-objdump's listing of an
 ELF with its DWARF line info, one row per instruction."""
 import glob, os, re, subprocess
 

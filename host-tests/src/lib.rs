@@ -604,6 +604,23 @@ pub fn hash_frame(hash: &mut u64, frame: &Frame, depth: &[u16]) {
     }
 }
 
+/// W4's mesh (`wraster::scenes::torus`), camera and render state, handed to `f` (the tests' way to the torus).
+pub fn with_torus<T>(
+    f: impl FnOnce(&wraster::mesh::Mesh<'_, Rgb565>, &wraster::projection::Camera, RenderState) -> T,
+) -> T {
+    use wraster::mesh::{Colors, Mesh};
+    use wraster::scenes::torus;
+    let (pos, idx, col) = (torus::positions(), torus::indices(), torus::colors());
+    let mesh = Mesh {
+        positions: &pos,
+        indices: &idx,
+        colors: Colors::PerFace(&col),
+    };
+    let cam = torus::camera().expect("W4's camera");
+    let state = cam.render_state().expect("W4's render state");
+    f(&mesh, &cam, state)
+}
+
 /// W4 frame `k` (`wraster::scenes::torus`) through the mesh path, transformed once and drawn in bands of `band_h`
 /// rows (the last may be shorter), each band's depth cleared first: the frame, its depth, the summed stats.
 pub fn render_torus<R: SpanRecip>(

@@ -5,7 +5,7 @@
 
 use embedded_graphics::pixelcolor::Rgb565;
 use embedded_graphics::prelude::{DrawTargetExt, Point};
-use host_tests::{in_bands, Frame};
+use host_tests::{in_bands, with_torus, Frame};
 use wraster::clip::Viewport;
 use wraster::mesh::{Colors, Mesh, Projected};
 use wraster::projection::{Camera, Mat4};
@@ -92,19 +92,6 @@ fn same_either_way(
         assert!(plain.frame == whole.frame && plain.depth == whole.depth);
     }
     whole.stats.written
-}
-
-/// W4's mesh, camera and render state, handed to `f`.
-fn with_torus<T>(f: impl FnOnce(&Mesh<'_, Rgb565>, &Camera, RenderState) -> T) -> T {
-    let (pos, idx, col) = (torus::positions(), torus::indices(), torus::colors());
-    let mesh = Mesh {
-        positions: &pos,
-        indices: &idx,
-        colors: Colors::PerFace(&col),
-    };
-    let cam = torus::camera().unwrap();
-    let state = cam.render_state().unwrap();
-    f(&mesh, &cam, state)
 }
 
 /// W4's eight frames, in bands of 1, 3, 4 (the Cortex-M0's), 7, 16 (the RP2040's) and 240 rows.

@@ -14,7 +14,7 @@
 //! as before this term existed, the test fails there). A pixel none of whose probes hits must stay empty.
 
 use embedded_graphics::pixelcolor::{Rgb565, RgbColor};
-use host_tests::{hash_frame, in_bands, render_torus, Frame};
+use host_tests::{hash_frame, in_bands, render_torus, with_torus, Frame};
 use wraster::clip::Viewport;
 use wraster::mesh::{Colors, Mesh, Projected};
 use wraster::projection::{Camera, Mat4};
@@ -229,14 +229,11 @@ fn torus_frames_match_the_f64_ray_caster_fast_div_int() {
 /// Its vertices differ from `FastDiv`'s f32 transform somewhere (otherwise this would not tell the two apart).
 #[test]
 fn fast_div_int_transforms_as_fast_and_draws_as_fast_div() {
-    let (pos, idx, col) = (torus::positions(), torus::indices(), torus::colors());
-    let mesh = Mesh {
-        positions: &pos,
-        indices: &idx,
-        colors: Colors::PerFace(&col),
-    };
-    let cam = torus::camera().unwrap();
-    let state = cam.render_state().unwrap();
+    with_torus(fast_div_int_frames);
+}
+
+fn fast_div_int_frames(mesh: &Mesh<'_, Rgb565>, cam: &Camera, state: RenderState) {
+    let n = mesh.positions.len();
     let vp = Viewport::new(0.0, 0.0, WIDTH as f32, HEIGHT as f32);
     let bits = |v: &[Projected]| -> Vec<[u32; 3]> {
         v.iter()
@@ -246,24 +243,18 @@ fn fast_div_int_transforms_as_fast_and_draws_as_fast_div() {
     let mut f32_differs = 0;
     for k in 0..torus::FRAMES {
         let m = cam.model_matrix(&torus::model(k));
-        let mut int_div = vec![Projected::default(); pos.len()];
-        let mut int_fast = vec![Projected::default(); pos.len()];
-        let mut f32_div = vec![Projected::default(); pos.len()];
+        let (mut int_div, mut int_fast, mut f32_div) = (
+            vec![Projected::default(); n],
+            vec![Projected::default(); n],
+            vec![Projected::default(); n],
+        );
         let mut r = Rasterizer::<FastDivInt>::new(state);
         let mut by_div = Rasterizer::<FastDiv>::new(state);
-        r.transform_mesh(&mesh, &m, &vp, &mut int_div).unwrap();
         Rasterizer::<Fast>::new(state)
-            .transform_mesh(&mesh, &m, &vp, &mut int_fast)
+            .transform_mesh(mesh, &m, &vp, &mut int_fast)
             .unwrap();
-        by_div.transform_mesh(&mesh, &m, &vp, &mut f32_div).unwrap();
-        assert_eq!(bits(&int_div), bits(&int_fast), "frame {k}");
-        f32_differs += bits(&int_div)
-            .iter()
-            .zip(bits(&f32_div))
-            .filter(|(a, b)| **a != *b)
-            .count();
-        let mut scratch = vec![Projected::default(); pos.len()];
-        let mf = r.transform_mesh(&mesh, &m, &vp, &mut scratch).unwrap();
+        by_div.transform_mesh(mesh, &m, &vp, &mut f32_div).unwrap();
+        let mf = r.transform_mesh(mesh, &m, &vp, &mut int_div).unwrap();
         let draw = |draw: &mut dyn FnMut(
             &mut Frame,
             &mut DepthBuffer<'_>,
@@ -278,6 +269,12 @@ fn fast_div_int_transforms_as_fast_and_draws_as_fast_div() {
         let b = draw(&mut |f, buf| by_div.draw_mesh_frame(f, buf, &mf));
         assert!(a.0 == b.0 && a.1 == b.1 && a.2 == b.2, "frame {k}");
         assert!(a.2 > 10_000, "frame {k}: {} pixels written", a.2);
+        assert_eq!(bits(&int_div), bits(&int_fast), "frame {k}");
+        f32_differs += bits(&int_div)
+            .iter()
+            .zip(bits(&f32_div))
+            .filter(|(a, b)| **a != *b)
+            .count();
     }
     assert!(
         f32_differs > 0,
