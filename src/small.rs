@@ -12,8 +12,8 @@
 //! pixel: `x` below `2^14` and `y` below `2^15` sub-pixels, `|A_k| < 2^15`, `|B_k| < 2^13`, so
 //! `|E_k| < 2^29 + 2^28` at every pixel centre of the box. A pixel is covered iff all three are `>= 0`: the top-left
 //! rule, exactly the general walk's pixels. Each row's covered run is found either from the column bounds of the two
-//! edges that bound the row (the long edge and one short one, [`Halves`]), walked in 32.32 fixed point that gives
-//! the exact columns (`crate::edge::Fixed`; 32-bit divisions at set-up, one add a row), or by scanning the row from
+//! edges that bound the row (the long edge and one short one, [`Halves`]), one division a row each that gives the
+//! exact columns (`crate::edge::DivBound`), or by scanning the row from
 //! the box's left column with the edge functions alone, past the uncovered pixels, then to the end of the run (the triangle is convex): [`ROWS_BY_DIVISION`] says which core takes which.
 //! The depth loop then walks the run.
 //!
@@ -56,7 +56,7 @@ use embedded_graphics_core::prelude::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 
 use crate::depth::DepthBuffer;
-use crate::edge::{flat_rows, Edge, Fixed, Side, Sub};
+use crate::edge::{flat_rows, DivBound, Sub};
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
 use crate::fast::{
@@ -416,14 +416,14 @@ trait Runs {
 /// the long edge and the bottom short edge. (Above the middle vertex the region between the long and the top edge lies
 /// strictly inside the bottom edge's half-plane, which it meets only at the middle vertex, so that edge's function is
 /// positive there and it binds no pixel; likewise below. On the row through the middle vertex both short edges cross
-/// the row at the vertex, on the same side, with the same bias: either gives the same bound.) Each bound is walked
-/// in 32.32 fixed point ([`Fixed`]: the exact columns, one 64-bit add a row), so a row costs two adds, and the
-/// bottom edge takes the top edge's place once, at the middle vertex's row.
+/// the row at the vertex, on the same side, with the same bias: either gives the same bound.) Each bound is one
+/// division a row ([`DivBound`]: the exact columns, no division at set-up), and the bottom edge takes the top edge's
+/// place once, at the middle vertex's row.
 struct Halves {
-    l: Fixed,
-    r: Fixed,
+    l: DivBound,
+    r: DivBound,
     /// The bottom short edge, positioned at its first row, and whether it replaces the right bound (else the left).
-    next: Fixed,
+    next: DivBound,
     next_right: bool,
     /// The row where `next` takes over (`i32::MAX`: none within the triangle's rows).
     from: i32,
@@ -452,9 +452,8 @@ impl Halves {
         };
         // The directed edge `(a, b)`, positioned at row `j`: whether it bounds the left side, and its bound.
         #[inline(always)]
-        fn edge((a, b): (Sub, Sub), j: i32, (ox, oy): (i32, i32)) -> Option<(bool, Fixed)> {
-            let e = Edge::new_small(a, b, j, ox, oy);
-            Some((matches!(e.side, Side::Left), Fixed::of(&e)?))
+        fn edge((a, b): (Sub, Sub), j: i32, (ox, oy): (i32, i32)) -> Option<(bool, DivBound)> {
+            DivBound::new(a, b, j, ox, oy)
         }
         let edge = |e: (Sub, Sub), j: i32| edge(e, j, (ox, oy));
         // The first row whose centre is at or below the middle vertex.
@@ -494,8 +493,8 @@ impl Halves {
 
 impl Runs for Halves {
     #[inline(always)]
-    fn run(&self, _: i32) -> (i32, i32) {
-        (self.l.lo(), self.r.hi())
+    fn run(&self, ox: i32) -> (i32, i32) {
+        (ox + self.l.lo(), ox + self.r.hi())
     }
     #[inline(always)]
     fn step(&mut self) {
