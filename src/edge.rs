@@ -219,6 +219,141 @@ impl DivBound {
     }
 }
 
+/// A column bound of a small triangle's row, walked row by row ([`DivBound`], [`ScanBound`]): relative to the box's
+/// origin column, a left edge's first admitted column ([`RowBound::lo`], 0 where that is left of the box) and a right
+/// edge's column one past its last ([`RowBound::hi`]).
+pub(crate) trait RowBound: Copy {
+    /// The directed edge `a -> b` of an oriented triangle whose snapped box (origin pixel `(ox, oy)`, `ncol` columns)
+    /// is under 127 px each way, at row `j`: whether it bounds the row on the left, and its bound; `None` for a
+    /// horizontal edge.
+    fn new(a: Sub, b: Sub, j: i32, ox: i32, oy: i32, ncol: i32) -> Option<(bool, Self)>;
+    fn lo(&self) -> i32;
+    fn hi(&self) -> i32;
+    /// Moves to the next row.
+    fn step(&mut self);
+}
+
+/// `N` of [`Edge::new_small`] for the edge `a -> b` at row `j` relative to `(ox, oy)`, `D = 256 |A|`, its growth a row
+/// `256 B`, and whether it is a left edge; `None` for a horizontal edge. `N` below `2^30`.
+#[inline(always)]
+fn small_edge(a: Sub, b: Sub, j: i32, ox: i32, oy: i32) -> Option<(bool, i32, i32, i32)> {
+    let (ax, ay) = (a.x - 256 * ox, a.y - 256 * oy);
+    let (bx, by) = (b.x - 256 * ox, b.y - 256 * oy);
+    let (a_, b_) = (ay - by, bx - ax);
+    if a_ == 0 {
+        return None;
+    }
+    let left = a_ > 0;
+    let n = a_ * (128 - ax) + b_ * (256 * (j - oy) + 128 - ay) - i32::from(!left);
+    Some((left, n, 256 * a_.abs(), 256 * b_))
+}
+
+impl RowBound for DivBound {
+    #[inline(always)]
+    fn new(a: Sub, b: Sub, j: i32, ox: i32, oy: i32, _: i32) -> Option<(bool, DivBound)> {
+        DivBound::new(a, b, j, ox, oy)
+    }
+    #[inline(always)]
+    fn lo(&self) -> i32 {
+        DivBound::lo(self)
+    }
+    #[inline(always)]
+    fn hi(&self) -> i32 {
+        DivBound::hi(self)
+    }
+    #[inline(always)]
+    fn step(&mut self) {
+        DivBound::step(self)
+    }
+}
+
+/// A bound found by stepping from the previous row's, for cores without a divide instruction (the Cortex-M0): the
+/// edge function `e` at the bound's column `c` (a left edge's first admitted column, clamped to 0; a right edge's last
+/// one, clamped to `ncol - 1`), `E` growing by `d = 256 |A|` a column towards the inside and by `s` a row. Each row
+/// adds `s`, then moves `c` a column at a time towards the inside while `e < 0`, or towards the outside while the next
+/// column out is admitted (`e - d >= 0`) and in the box: the same columns as [`DivBound`] where they lie in the box.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ScanBound {
+    c: i32,
+    e: i32,
+    d: i32,
+    s: i32,
+    /// The clamp on the outside: 0 for a left edge, `ncol - 1` for a right one.
+    edge: i32,
+    left: bool,
+}
+
+impl ScanBound {
+    #[inline(always)]
+    fn settle(&mut self) {
+        if self.left {
+            if self.e < 0 {
+                while self.e < 0 {
+                    self.c += 1;
+                    self.e += self.d;
+                }
+            } else {
+                while self.c > self.edge && self.e - self.d >= 0 {
+                    self.c -= 1;
+                    self.e -= self.d;
+                }
+            }
+        } else if self.e < 0 {
+            while self.e < 0 {
+                self.c -= 1;
+                self.e += self.d;
+            }
+        } else {
+            while self.c < self.edge && self.e - self.d >= 0 {
+                self.c += 1;
+                self.e -= self.d;
+            }
+        }
+    }
+}
+
+impl RowBound for ScanBound {
+    #[inline(always)]
+    fn new(a: Sub, b: Sub, j: i32, ox: i32, oy: i32, ncol: i32) -> Option<(bool, ScanBound)> {
+        let (left, n, d, s) = small_edge(a, b, j, ox, oy)?;
+        // E at column c is n + c D (left) or n - c D (right).
+        let mut b = if left {
+            ScanBound {
+                c: 0,
+                e: n,
+                d,
+                s,
+                edge: 0,
+                left,
+            }
+        } else {
+            ScanBound {
+                c: ncol - 1,
+                e: n - (ncol - 1) * d,
+                d,
+                s,
+                edge: ncol - 1,
+                left,
+            }
+        };
+        b.settle();
+        Some((left, b))
+    }
+    #[inline(always)]
+    fn lo(&self) -> i32 {
+        self.c
+    }
+    #[inline(always)]
+    fn hi(&self) -> i32 {
+        self.c + 1
+    }
+    #[inline(always)]
+    fn step(&mut self) {
+        self.e += self.s;
+        self.settle();
+    }
+}
+
 /// The rows `(first, last)` of a triangle with positive doubled area (`p` oriented), from the rows whose centre lies
 /// in its vertices' y-range, less the row whose centres lie exactly on a horizontal bottom edge: with `A = 0` and
 /// `B < 0` (interior above) the edge is not top-left, and its `N = B (256 j + 128 - y) - 1` is negative exactly from
@@ -237,6 +372,66 @@ pub(crate) fn flat_rows(p: &[Sub; 3], (first, mut last): (i32, i32)) -> (i32, i3
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The stepped bound gives the same columns as the exact quotient-and-remainder walk, row by row for 126 rows, on
+    /// random small edges of either side set up at any row, in boxes of 1 to 32 columns: a left edge's first column
+    /// where it is right of the box's first (else 0), a right edge's bound where it is left of the box's end (else
+    /// the box's end), whatever the rows before.
+    #[test]
+    fn stepped_bounds_walk_the_exact_columns() {
+        let mut rnd = crate::xorshift(0x5eed_f00d_1234_5678);
+        let mut coord = move |n: i64| (rnd() % n as u64) as i32;
+        let (mut inside, mut clamped) = (0u32, 0u32);
+        for _ in 0..100_000 {
+            let (ox, oy) = (coord(600) - 300, coord(600) - 300);
+            let ncol = 1 + coord(32);
+            let sub = |x: i32, y: i32| Sub {
+                x: 256 * ox + x,
+                y: 256 * oy + y,
+            };
+            let (a, b) = (
+                sub(coord(ncol as i64 * 256), coord(126 * 256)),
+                sub(coord(ncol as i64 * 256), coord(126 * 256)),
+            );
+            let j = oy + coord(8);
+            let mut e = Edge::new_small(a, b, j, ox, oy);
+            let Some((is_left, mut f)) = <ScanBound as RowBound>::new(a, b, j, ox, oy, ncol) else {
+                assert!(matches!(e.side, Side::Flat));
+                continue;
+            };
+            assert_eq!(is_left, matches!(e.side, Side::Left));
+            for _ in 0..126 {
+                match e.side {
+                    Side::Left => {
+                        let want = -e.q - ox;
+                        assert_eq!(f.lo(), want.max(0), "{a:?} {b:?} {ncol}");
+                        if want > 0 {
+                            inside += 1
+                        } else {
+                            clamped += 1
+                        }
+                    }
+                    Side::Right => {
+                        let want = e.q + 1 - ox;
+                        assert_eq!(f.hi(), want.min(ncol), "{a:?} {b:?} {ncol}");
+                        if want < ncol {
+                            inside += 1
+                        } else {
+                            clamped += 1
+                        }
+                    }
+                    Side::Flat => unreachable!(),
+                }
+                e.step();
+                RowBound::step(&mut f);
+            }
+        }
+        // Both the exact and the clamped case are exercised.
+        assert!(
+            inside > 1_000_000 && clamped > 1_000_000,
+            "{inside} {clamped}"
+        );
+    }
 
     /// The division bound gives the same columns as the exact quotient-and-remainder walk, row by row, for 126 rows
     /// (the small triangles' most), on random small edges of either side, set up at any row: a left edge's first
