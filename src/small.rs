@@ -13,10 +13,8 @@
 //! `|E_k| < 2^29 + 2^28` at every pixel centre of the box. A pixel is covered iff all three are `>= 0`: the top-left
 //! rule, exactly the general walk's pixels. Each row's covered run is found either from the column bounds of the two
 //! edges that bound the row (the long edge and one short one, [`Halves`]), one division a row each that gives the
-//! exact columns (`crate::edge::DivBound`), or, on a core without a divide instruction, by scanning the row from
-//! the box's left column with the edge functions alone, past the uncovered pixels, then to the end of the run (the
-//! triangle is convex), or in a box of [`TRACK_FROM`] columns or more by stepping each of those two bounds from the
-//! previous row's (`crate::edge::ScanBound`): [`ROWS_BY_DIVISION`] says which core takes which.
+//! exact columns (`crate::edge::DivBound`), or by scanning the row from
+//! the box's left column with the edge functions alone, past the uncovered pixels, then to the end of the run (the triangle is convex): [`ROWS_BY_DIVISION`] says which core takes which.
 //! The depth loop then walks the run.
 //!
 //! **Depth without a plane solve.** The edge function of the edge opposite vertex `k` is `2A` (the doubled area) at
@@ -58,7 +56,7 @@ use embedded_graphics_core::prelude::{Point, Size};
 use embedded_graphics_core::primitives::Rectangle;
 
 use crate::depth::DepthBuffer;
-use crate::edge::{flat_rows, DivBound, RowBound, ScanBound, Sub};
+use crate::edge::{flat_rows, DivBound, Sub};
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
 use crate::fast::{
@@ -216,21 +214,14 @@ fn draw_as<S: FreshSeed, D: DrawTarget, const DIV: bool, const KEEP: bool>(
             (walk, keep)
         }
     };
-    let scan_ncol = ((xmax - 128) >> SUBPIXEL_BITS) - ox + 1;
     let scan = Scan {
         e,
         ex,
         ey,
-        ncol: scan_ncol,
+        ncol: ((xmax - 128) >> SUBPIXEL_BITS) - ox + 1,
     };
     let stats = if DIV {
-        let Some(halves) = Halves::<DivBound>::new(&pa, j0, j1, ox, oy, 0) else {
-            return Ok(None);
-        };
-        walk.rows::<S, D, _>(target, depth, halves, color)?
-    } else if scan_ncol >= TRACK_FROM {
-        // A wide box: each bound stepped from the previous row's (fewer steps than a scan across the box).
-        let Some(halves) = Halves::<ScanBound>::new(&pa, j0, j1, ox, oy, scan_ncol) else {
+        let Some(halves) = Halves::new(&pa, j0, j1, ox, oy) else {
             return Ok(None);
         };
         walk.rows::<S, D, _>(target, depth, halves, color)?
@@ -408,11 +399,6 @@ fn constants<const KEEP: bool>(
 /// call of some 60 instructions, and a small triangle's edges would take six). Both give exactly the pixels whose
 /// three edge functions are `>= 0` (the unit tests compare them).
 const ROWS_BY_DIVISION: bool = !cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
-/// Where rows are found without division: the box's width in columns from which each row's bounds are stepped from
-/// the previous row's ([`ScanBound`]) rather than scanned across the box ([`Scan`]). Measured on the Cortex-M0 (the
-/// same pixels either way): from 16 columns, terrain -6.1% a pixel and W4 -0.9% a frame, W3 (boxes of a few columns)
-/// +0.2% (its registers allocated around both ways); from 8 or 12, W4 -0.2% and -0.8%; for every box, W3 +0.9%.
-const TRACK_FROM: i32 = 16;
 
 /// A row's covered run `[lo, hi)` (columns of the frame; empty when `lo >= hi`), and the step to the next row.
 trait Runs {
@@ -433,22 +419,22 @@ trait Runs {
 /// the row at the vertex, on the same side, with the same bias: either gives the same bound.) Each bound is one
 /// division a row ([`DivBound`]: the exact columns, no division at set-up), and the bottom edge takes the top edge's
 /// place once, at the middle vertex's row.
-struct Halves<B> {
-    l: B,
-    r: B,
+struct Halves {
+    l: DivBound,
+    r: DivBound,
     /// The bottom short edge, positioned at its first row, and whether it replaces the right bound (else the left).
-    next: B,
+    next: DivBound,
     next_right: bool,
     /// The row where `next` takes over (`i32::MAX`: none within the triangle's rows).
     from: i32,
 }
 
-impl<B: RowBound> Halves<B> {
+impl Halves {
     /// The oriented snapped triangle `p`'s bounds from row `j0` to `j1` (`None` where the triangle is not as the
     /// rows need: not reached for a triangle of positive area, whose long edge is not horizontal and whose short
     /// edges lie on the other side; the general path then draws it).
     #[inline(always)]
-    fn new(p: &[Sub; 3], j0: i32, j1: i32, ox: i32, oy: i32, ncol: i32) -> Option<Halves<B>> {
+    fn new(p: &[Sub; 3], j0: i32, j1: i32, ox: i32, oy: i32) -> Option<Halves> {
         // Rotated (the orientation kept) so that vertex 0 is a topmost one; the directed edges are then `0 -> 1`,
         // `1 -> 2`, `2 -> 0`, and the bottom vertex is 1 or 2.
         let q = if p[0].y <= p[1].y && p[0].y <= p[2].y {
@@ -465,7 +451,11 @@ impl<B: RowBound> Halves<B> {
             ((q[2], q[0]), (q[0], q[1]), (q[1], q[2]), q[1].y)
         };
         // The directed edge `(a, b)`, positioned at row `j`: whether it bounds the left side, and its bound.
-        let edge = |(a, b): (Sub, Sub), j: i32| B::new(a, b, j, ox, oy, ncol);
+        #[inline(always)]
+        fn edge((a, b): (Sub, Sub), j: i32, (ox, oy): (i32, i32)) -> Option<(bool, DivBound)> {
+            DivBound::new(a, b, j, ox, oy)
+        }
+        let edge = |e: (Sub, Sub), j: i32| edge(e, j, (ox, oy));
         // The first row whose centre is at or below the middle vertex.
         let jm = (ym - 128 + 255) >> SUBPIXEL_BITS;
         let (long_left, long) = edge(long_e, j0)?;
@@ -501,7 +491,7 @@ impl<B: RowBound> Halves<B> {
     }
 }
 
-impl<B: RowBound> Runs for Halves<B> {
+impl Runs for Halves {
     #[inline(always)]
     fn run(&self, ox: i32) -> (i32, i32) {
         (ox + self.l.lo(), ox + self.r.hi())
@@ -929,8 +919,7 @@ mod tests {
         }
     }
 
-    /// Finding the runs by division and without (by scanning, or in boxes of [`TRACK_FROM`] columns and more by
-    /// stepping the bounds) gives the same pixels, codes and counts: random small
+    /// Finding the runs by division and by scanning gives the same pixels, codes and counts: random small
     /// triangles on and off the snap grid, in the whole frame and in bands of 5 rows, over a depth buffer already
     /// holding a random surface (so some pixels fail), with both seeds.
     #[test]
@@ -938,7 +927,7 @@ mod tests {
         let mut rnd = xorshift(0x9E37_79B9_7F4A_7C15);
         let mut unit = move || (rnd() >> 11) as f32 / (1u64 << 53) as f32;
         let r = Rasterizer::<Fast>::new(RenderState::new(1.0, 100.0).unwrap());
-        let (mut taken, mut pixels, mut wide) = (0, 0u32, 0u32);
+        let (mut taken, mut pixels) = (0, 0u32);
         for k in 0..20_000 {
             let (cx, cy) = (unit() * 70.0 - 3.0, unit() * 70.0 - 3.0);
             // Up to 40 px wide: some beyond the path's 32 px (those it leaves to the general path in both ways).
@@ -1015,18 +1004,11 @@ mod tests {
             if let Some((fr, _, _)) = out[0].2 {
                 taken += 1;
                 pixels += fr;
-                // Boxes whose rows are stepped where there is no division (`TRACK_FROM` columns and more).
-                let xs = setup.p.map(|p| p.x);
-                let (xmin, xmax) = (xs.iter().min().unwrap(), xs.iter().max().unwrap());
-                wide += u32::from(((xmax - 128) >> 8) - (xmin >> 8) + 1 >= TRACK_FROM);
             }
         }
-        // A guard that the comparison exercises the path: most triangles are taken (18,865 of 20,000 when written),
-        // and they cover many pixels (104,505), 1,223 of them in wide boxes.
-        assert!(
-            taken > 10_000 && pixels > 50_000 && wide > 200,
-            "{taken} {pixels} {wide}"
-        );
+        // A guard that the comparison exercises the path: most triangles are taken (17,434 of 20,000 when written),
+        // and they cover many pixels (104,494).
+        assert!(taken > 10_000 && pixels > 50_000, "{taken} {pixels}");
     }
 
     /// The path against the exact tier (`Rasterizer<Exact>::draw`, the general set-up and the correctly rounded
