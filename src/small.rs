@@ -451,11 +451,7 @@ impl Halves {
             ((q[2], q[0]), (q[0], q[1]), (q[1], q[2]), q[1].y)
         };
         // The directed edge `(a, b)`, positioned at row `j`: whether it bounds the left side, and its bound.
-        #[inline(always)]
-        fn edge((a, b): (Sub, Sub), j: i32, (ox, oy): (i32, i32)) -> Option<(bool, DivBound)> {
-            DivBound::new(a, b, j, ox, oy)
-        }
-        let edge = |e: (Sub, Sub), j: i32| edge(e, j, (ox, oy));
+        let edge = |(a, b): (Sub, Sub), j: i32| DivBound::new(a, b, j, ox, oy);
         // The first row whose centre is at or below the middle vertex.
         let jm = (ym - 128 + 255) >> SUBPIXEL_BITS;
         let (long_left, long) = edge(long_e, j0)?;
