@@ -300,10 +300,7 @@ fn constants<const KEEP: bool>(
     let margin = margin(t_max);
     let t_hi = state.range.t_max(s.frac);
     // `2^F` from 32-bit pieces on the Cortex-M0 ([`shl64`]; `F <= 61`), where `1 << F` is a library call.
-    if t_min < margin
-        || t_min - margin < shl64(1, s.frac)
-        || t_max + margin > t_hi
-        || t_min < 1 << 56
+    if t_min < margin || bits(t_min - margin) <= s.frac || t_max + margin > t_hi || t_min < 1 << 56
     {
         return None;
     }
@@ -353,7 +350,9 @@ fn constants<const KEEP: bool>(
     // `2A T'` below 2^63 (`bits(2A) + bits(T'_max) <= 63`), so the wrapping product is exact; `2A < 2^29`.
     #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
     let (lz, same) = {
-        let lz_of = |t: u64| lz_small((shl64(wmul(area2 as i32, t), sh) >> 32) as u32);
+        // The leading zeros of the high word of `2A T' 2^sh` (below `2^63`, at least `2^55`): those of `2A T'`
+        // less `sh`.
+        let lz_of = |t: u64| 64 - bits(wmul(area2 as i32, t)) - sh;
         let lz = lz_of(tp_max);
         (lz, lz_of(tp_min) == lz)
     };
