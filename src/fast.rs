@@ -690,7 +690,7 @@ fn walk<const UP: bool, S: FreshSeed, D: DrawTarget, const COARSE: bool>(
 
 /// Cores without a count-leading-zeros instruction, where `leading_zeros` is a library call: ARMv6-M (Cortex-M0,
 /// which has no 32-bit atomics either) and RV32IMAC (no Zbb).
-const NO_CLZ: bool = cfg!(any(
+pub(crate) const NO_CLZ: bool = cfg!(any(
     all(target_arch = "arm", not(target_has_atomic = "32")),
     target_arch = "riscv32"
 ));
