@@ -131,8 +131,8 @@ const fn seed_table() -> [u32; CELLS] {
 /// [`crate::recip::FastDiv`]).
 pub(crate) trait FreshSeed: Sized {
     /// Whether the chained loop carries `x` from pixel to pixel on a binade whose step of `v` (the walked 64-bit
-    /// value) is `dv`: at most the strategy's bound on `r = |dv| / v`. A strategy that never chains says `false` in
-    /// its own body (a constant the loops are compiled without; a generic comparison there measured M0 W1 3% more).
+    /// value) is `dv`: at most the strategy's bound on `r = |dv| / v`. A strategy that never chains says `false` (a
+    /// constant: its loops are compiled without the chained one).
     fn chains<const UP: bool>(dv: i64) -> bool;
     /// `2^61 / m`, fresh.
     fn fresh61(m: u32) -> i32;
@@ -159,8 +159,8 @@ pub(crate) trait FreshSeed: Sized {
 ///
 /// It never chains: the chained loop (the extrapolated seed rounded to 17 bits and the same step, within bound for
 /// `r <= 2^-9`) took 54 instructions a pixel on the M0 against the fresh loop's 50 (its carried values spill from
-/// the eight low registers), and without it the M0's W1 went from 64.9 to 62.6 instructions a pixel and W2 from 39.9
-/// to 38.7 a fragment.
+/// the eight low registers), and without it (and with [`quarter_product`]'s residual) the M0's W1 went from 64.9 to
+/// 62.7 instructions a pixel and W2 from 39.9 to 39.0 a fragment.
 pub(crate) struct Chord;
 
 impl FreshSeed for Chord {
@@ -196,7 +196,7 @@ fn chord_masked(m: u32) -> u32 {
 }
 
 /// [`chord_seed`] without a mask, for the Cortex-M0, which has no immediate for one (each a constant loaded and a
-/// register held: measured W1 -1.6%, W2 -1.3% instructions against [`chord_masked`]). Its table has 512 cells whose
+/// register held: measured W1 62.7 -> 59.7 instructions a pixel, W2 39.0 -> 38.0 a fragment against [`chord_masked`]). Its table has 512 cells whose
 /// first half is never read, indexed by `c = m >> 23` alone (`256 + k`); and with `m >> 12 = 2048 c + u`,
 /// `(drop (m >> 12)) >> 10 = ((drop u) >> 10) + 2 c drop` exactly (the added product is a multiple of `2^10`), so
 /// the cell holds `y' = y + 2 c drop` (below `2^21`, checked as the table is built) with `drop` on top: the same `X`
@@ -229,7 +229,7 @@ fn chord_unmasked(m: u32) -> u32 {
 /// One Newton-Raphson step on `2^61 / m` from a 17-bit seed `x0` near `2^48 / m` with relative error `|delta| <
 /// 2^-15.5` (`x0 <= 2^17 + 5`), in 32-bit products only. With `m = mh 2^14 + ml` (`mh` 18 bits, `ml` 14), the
 /// residual `E = 2^48 - m x0 = 2^48 delta'` (`|E| < 2^32.5`) is formed as `e = E >> 2 = -((mh x0) << 12) - ((ml x0)
-/// >> 2)` modulo `2^32` (exact: `|e| < 2^30.5`; `ml x0 < 2^14 (2^17 + 5) < 2^32` does not wrap; the first product
+/// >> 2)` modulo `2^32` ([`quarter_product`], which the M0 forms from other pieces of `m`, the same bits) (exact: `|e| < 2^30.5`; `ml x0 < 2^14 (2^17 + 5) < 2^32` does not wrap; the first product
 /// may, harmlessly), and `x = x0 2^13 (1 + delta') = (x0 << 13) + floor((x0 >> 2)(e >> 15) / 2^16)` (the product is
 /// below `2^15.1 2^15.5 < 2^31`).
 ///
