@@ -1800,6 +1800,56 @@ mod tests {
         check::<crate::recip::FastDiv>();
     }
 
+    /// A list frame's draw (the memo draw, which snaps every vertex before it checks any `1/W`) reports the error
+    /// [`Rasterizer::draw`] reports (its checks vertex by vertex: `z` and `1/W`, then the position, then `T`'s
+    /// range), whatever mix of bad vertices a triangle has, and writes nothing: every vertex in each of seven kinds
+    /// (good, `z` NaN, `1/W` NaN, `1/W <= 0`, `x` NaN, `y` beyond the guard band, `T` beyond its range) at each of the
+    /// three places (343 triangles), for both fast-tier seeds and the exact tier.
+    #[test]
+    fn a_list_frame_reports_the_error_draw_reports() {
+        use crate::{ColorBand, Vertex};
+        use embedded_graphics_core::pixelcolor::{Rgb565, RgbColor};
+        let kind = |k: usize, at: (f32, f32)| {
+            let mut v = Vertex::new(at.0, at.1, 20.0, Rgb565::RED);
+            match k {
+                1 => v.z = f32::NAN,
+                2 => v.rhw = f32::NAN,
+                3 => v.rhw = -0.5,
+                4 => v.x = f32::NAN,
+                5 => v.y = 1.0e5,
+                6 => v.rhw = 1.0e12, // T = rhw W_far far beyond 2^30
+                _ => {}
+            }
+            v
+        };
+        fn check<R: SpanRecip>(tris: &[[Vertex<Rgb565>; 3]]) -> usize {
+            let mut r = Rasterizer::<R>::new(RenderState::new(1.0, 500.0).unwrap());
+            let mut cache = PlaneCache::<8>::new();
+            let frame = cache.list(tris);
+            let (mut cp, mut zp) = (vec![0u16; 32 * 32], vec![0u16; 32 * 32]);
+            let mut errors = 0;
+            for (k, t) in tris.iter().enumerate() {
+                let mut band = ColorBand::<Rgb565>::band(&mut cp, 32, 0, 32).unwrap();
+                let mut depth = DepthBuffer::band(&mut zp, 32, 0, 32).unwrap();
+                depth.clear();
+                let plain = r.draw(&mut band, &mut depth, t).err();
+                let listed = r.draw_listed(&mut band, &mut depth, &frame, k).err();
+                assert_eq!(plain, listed, "triangle {k}");
+                assert!(plain.is_none() || depth.data().iter().all(|&c| c == u16::MAX));
+                errors += usize::from(plain.is_some());
+            }
+            errors
+        }
+        let at = [(2.0, 2.0), (20.0, 4.0), (6.0, 25.0)];
+        let tris: Vec<_> = (0..343)
+            .map(|n| [0, 1, 2].map(|i| kind(n / 7usize.pow(i as u32) % 7, at[i])))
+            .collect();
+        // Every triangle but the all-good one is an error.
+        assert_eq!(check::<crate::recip::Fast>(&tris), 342);
+        assert_eq!(check::<crate::recip::FastDiv>(&tris), 342);
+        assert_eq!(check::<crate::recip::Exact>(&tris), 342);
+    }
+
     /// A list frame ([`PlaneCache::list`], [`Rasterizer::draw_listed`]) draws exactly what [`Rasterizer::draw`]
     /// draws (colours, codes, statistics), band by band, on random lists of large, medium and small triangles, on
     /// the snap grid and off it, for the fast tier (both seeds) and the exact tier; with room for every triangle,

@@ -63,6 +63,84 @@ pub struct Rasterizer<R: WSpan = Fast> {
     pub(crate) zc: Option<(crate::DepthRange, crate::state::ZConst)>,
 }
 
+/// `t = rhw W_far` of one vertex as the exact product of the mantissas (`rhw = m 2^e`, `W_far = fm 2^fe`, both
+/// positive), `pm 2^pe`, and its bit count; [`Error::DepthRange`] where `t` reaches `2^MAX_T_LOG2`.
+#[inline(always)]
+fn t_exact(m: u32, e: i32, fm: u32, fe: i32) -> Result<(u64, i32, i32), Error> {
+    let (pm, pe) = (crate::fast::mul_wide(m, fm), e + fe);
+    let b = crate::fast::bits64(pm) as i32 + pe;
+    if b > MAX_T_LOG2 {
+        return Err(Error::DepthRange);
+    }
+    Ok((pm, pe, b))
+}
+
+/// The vertices' exact `T` (mantissas and exponents) and the largest bit count, as [`Rasterizer::setup_unrounded`]
+/// computes and checks them (`far` the far plane's `W`), for the memo draws ([`Rasterizer::setup_snapped_first`]).
+/// Out of line: one copy for every strategy (the Cortex-M0's flash, whose standard firmware draws with four).
+#[inline(never)]
+fn t_values<V: VertexInput, const N: usize>(
+    far: f32,
+    v: &[V; N],
+) -> Result<([(u64, i32); N], i32), Error> {
+    let (_, fm, fe) = split(far).ok_or(Error::NonFinite)?;
+    let mut tm = [(0u64, 0i32); N];
+    let mut int_bits = 0;
+    for k in 0..N {
+        let (m, e) = v[k].rhw_exact()?;
+        let (pm, pe, b) = t_exact(m, e, fm, fe)?;
+        int_bits = int_bits.max(b);
+        tm[k] = (pm, pe);
+    }
+    Ok((tm, int_bits))
+}
+
+/// The error [`Rasterizer::setup_unrounded`] reports where vertex `k` is the first that does not snap (`e`): its
+/// checks come vertex by vertex (`1/W`, then the position, then `T`'s range), after the far plane's.
+#[inline(never)]
+#[cold]
+fn snap_error<V: VertexInput>(far: f32, v: &[V], k: usize, e: Error) -> Error {
+    let Some((_, fm, fe)) = split(far) else {
+        return Error::NonFinite;
+    };
+    for (j, vj) in v.iter().enumerate().take(k + 1) {
+        match vj.rhw_exact() {
+            Err(e) => return e,
+            Ok((m, ex)) if j < k => {
+                if let Err(e) = t_exact(m, ex, fm, fe) {
+                    return e;
+                }
+            }
+            Ok(_) => {}
+        }
+    }
+    e
+}
+
+/// A [`Setup`] without a depth grid from the snapped positions and the vertices' exact `T` (mantissas and
+/// exponents), with the common fraction count `F = 61 - bits(floor(t_max))` (`t_max < 2^30`).
+#[inline(always)]
+fn assemble<const N: usize>(
+    p: [Sub; N],
+    on_grid: bool,
+    tm: [(u64, i32); N],
+    int_bits: i32,
+) -> (Setup<N>, [i32; N]) {
+    (
+        Setup {
+            p,
+            on_grid,
+            q: [Sub { x: 0, y: 0 }; N],
+            dbits: SUBPIXEL_BITS,
+            dorigin: (0, 0),
+            fast_t: None,
+            t: tm.map(|(m, _)| m as i64),
+            frac: (61 - int_bits) as u32,
+        },
+        tm.map(|(_, e)| e),
+    )
+}
+
 impl<R: WSpan> Rasterizer<R> {
     /// A rasterizer with `state`.
     pub fn new(state: RenderState) -> Self {
@@ -113,30 +191,40 @@ impl<R: WSpan> Rasterizer<R> {
             let (x, y, exact) = v[k].snapped_exact()?;
             p[k] = Sub { x, y };
             on_grid &= exact;
-            // `t = rhw W_far` as an exact product of the mantissas (`m > 0`, `fm > 0`), `pm 2^pe`, and its bit count.
-            let (pm, pe) = (crate::fast::mul_wide(m, fm), e + fe);
-            let b = crate::fast::bits64(pm) as i32 + pe;
-            if b > MAX_T_LOG2 {
-                return Err(Error::DepthRange);
-            }
+            let (pm, pe, b) = t_exact(m, e, fm, fe)?;
             int_bits = int_bits.max(b);
             tm[k] = (pm, pe);
         }
-        // F = 61 - bits(floor(t_max)), t_max < 2^30.
-        let frac = (61 - int_bits) as u32;
-        Ok((
-            Setup {
-                p,
-                on_grid,
-                q: [Sub { x: 0, y: 0 }; N],
-                dbits: SUBPIXEL_BITS,
-                dorigin: (0, 0),
-                fast_t: None,
-                t: tm.map(|(m, _)| m as i64),
-                frac,
-            },
-            tm.map(|(_, e)| e),
-        ))
+        Ok(assemble(p, on_grid, tm, int_bits))
+    }
+
+    /// [`Rasterizer::setup_unrounded`] in two steps for a memo draw: the snapped positions first, and `T` only where
+    /// `need_t` says, given them (it takes what a band remembered, which needs the positions); `T` is left 0 where it
+    /// does not (the band that remembered the values checked these vertices, which the frame does not change). The
+    /// same values and the same error as [`Rasterizer::setup_unrounded`] wherever `T` is computed, a vertex that
+    /// does not snap included ([`snap_error`]).
+    #[inline(always)]
+    pub(crate) fn setup_snapped_first<V: VertexInput, const N: usize>(
+        &self,
+        v: &[V; N],
+        need_t: impl FnOnce(&[Sub; N]) -> bool,
+    ) -> Result<(Setup<N>, [i32; N]), Error> {
+        let mut p = [Sub { x: 0, y: 0 }; N];
+        let mut on_grid = true;
+        for k in 0..N {
+            let (x, y, exact) = match v[k].snapped_exact() {
+                Ok(r) => r,
+                Err(e) => return Err(snap_error(self.state.range.far(), v, k, e)),
+            };
+            p[k] = Sub { x, y };
+            on_grid &= exact;
+        }
+        let (tm, int_bits) = if need_t(&p) {
+            t_values(self.state.range.far(), v)?
+        } else {
+            ([(0, 0); N], 0)
+        };
+        Ok(assemble(p, on_grid, tm, int_bits))
     }
 
     /// A triangle's vertices `v` (snapped and checked as `s`) on the depth grid, where it is off the snap grid: `q`,
@@ -406,23 +494,31 @@ impl<R: SpanRecip> Rasterizer<R> {
     {
         let (cmp, write) = self.w16_test()?;
         depth.note_compare(cmp, write);
-        // With a memo, the vertices' `T` rounded and the depth grid only where what it remembered does not stand in
-        // for them (below).
-        let (mut s, te) = if M::KEEPS {
-            self.setup_unrounded(v)?
-        } else {
-            (self.setup(v)?, [0; 3])
-        };
         // Only for a triangle with rows in the buffer (a band's draws include triangles that only come near it):
         // one that has none draws nothing either way, and both paths find that before they look at `fast_t`.
-        let (p, y0, y_last) = (
-            s.p,
+        let (y0, y_last) = (
             depth.y0(),
             depth.y0().saturating_add(depth.height() as i32 - 1),
         );
-        let in_buffer = move || {
-            let (first, last) = rows_of(&p);
+        let in_buffer = move |p: &[Sub; 3]| {
+            let (first, last) = rows_of(p);
             (first <= y_last && last >= y0).then_some(last)
+        };
+        // With a memo, the snapped positions first, then what an earlier band remembered of a triangle with rows
+        // here, then the vertices' `T` unless that is a small triangle's constants (which stand in for them: on the
+        // Cortex-M0's W4, some 740 of a frame's 1,535 draws), then (below) `T` rounded and the depth grid only where
+        // what it remembered does not stand in for them.
+        let (mut taken, mut kept_row) = (None, None);
+        let (mut s, te) = if M::KEEPS {
+            self.setup_snapped_first(v, |p| {
+                kept_row = in_buffer(p);
+                if kept_row.is_some() {
+                    taken = memo.take();
+                }
+                !matches!(taken, Some(Remember::Small(_)))
+            })?
+        } else {
+            (self.setup(v)?, [0; 3])
         };
         // Without a memo (`M::KEEPS` false, a constant: the branches below are not compiled) the values where a
         // path reads them, as ever. With one, what an earlier band of the frame remembered: the depth-grid values,
@@ -431,11 +527,8 @@ impl<R: SpanRecip> Rasterizer<R> {
         let mut solved = None;
         let mut small_kept = None;
         let mut remembered_small = false;
-        let mut kept_row = None;
         if M::KEEPS {
-            if let Some(last) = in_buffer() {
-                kept_row = Some(last);
-                let taken = memo.take();
+            if kept_row.is_some() {
                 if let Some(Remember::Small(k)) = taken {
                     (small_kept, remembered_small) = (Some(k), true);
                 } else {
@@ -452,7 +545,7 @@ impl<R: SpanRecip> Rasterizer<R> {
             } else {
                 Self::round_t(&mut s, te);
             }
-        } else if R::FAST_W16 && !s.on_grid && in_buffer().is_some() {
+        } else if R::FAST_W16 && !s.on_grid && in_buffer(&s.p).is_some() {
             s.fast_t = self.fast_t(&s);
         }
         // (A remembered small triangle's draw reads no depth-grid values: its constants stand for them.)
@@ -461,7 +554,7 @@ impl<R: SpanRecip> Rasterizer<R> {
             && !s.on_grid
             && solved.is_none()
             && !remembered_small
-            && in_buffer().is_some()
+            && in_buffer(&s.p).is_some()
         {
             FAST_T_USED.with(|c| c.borrow_mut().push((s.p.map(|p| (p.x, p.y)), s.fast_t)));
         }
@@ -507,7 +600,10 @@ impl<R: SpanRecip> Rasterizer<R> {
         }
         if remembered_small {
             // Remembered for the small-triangle path, which did not draw it here (its conditions changed): the
-            // values the general set-up reads.
+            // values the general set-up reads, `T` first (not computed above).
+            let (tm, int_bits) = t_values(self.state.range.far(), v)?;
+            let te;
+            (s, te) = assemble(s.p, s.on_grid, tm, int_bits);
             Self::round_t(&mut s, te);
             self.depth_values(&mut s, v);
         }
@@ -915,6 +1011,70 @@ mod tests {
     use crate::setup::*;
 
     use crate::fixed::div_u128_shift;
+
+    /// A memo draw whose memo remembers a small triangle's constants (so it skips the vertices' `T`) for a triangle
+    /// the small-triangle path then declines (here: boxes of 40 to 120 px, beyond its 32) computes `T` after all and
+    /// draws what [`Rasterizer::draw`] draws (codes, colours, statistics): that draw's fallback, which a real memo
+    /// reaches only in rare cases, exercised directly; off and on the snap grid, for both fast-tier seeds.
+    #[test]
+    fn a_remembered_small_triangle_declined_draws_what_draw_draws() {
+        use crate::{ColorBand, DepthBuffer};
+        use embedded_graphics_core::pixelcolor::{raw::RawU16, Rgb565};
+        // Remembers made-up small-triangle constants for every triangle.
+        struct Liar;
+        impl TMemo for Liar {
+            fn take(&mut self) -> Option<Remember> {
+                Some(Remember::Small(crate::small::Kept {
+                    s_o: 1 << 62,
+                    sx: 1 << 40,
+                    sy: 1 << 41,
+                    shifts: core::num::NonZeroU16::new(20).unwrap(),
+                }))
+            }
+            fn keep(&mut self, _: Remember, _: i32) {}
+        }
+        fn check<R: SpanRecip + WSpan>() {
+            let mut rnd = crate::xorshift(0x1234_5678_9ABC_DEF1);
+            let mut unit = move || (rnd() >> 11) as f64 / (1u64 << 53) as f64;
+            let mut r = Rasterizer::<R>::new(RenderState::new(1.0, 500.0).unwrap());
+            let mut drawn = 0;
+            for k in 0..200 {
+                let size = 40.0 + unit() * 80.0;
+                let c = Rgb565::from(RawU16::new((unit() * 65535.0) as u16));
+                // The first two vertices `size` apart across: the box is at least 40 px wide.
+                let v: [Vertex<Rgb565>; 3] = core::array::from_fn(|i| {
+                    let (mut x, mut y) = ([1.0, 1.0 + size, unit() * size][i], unit() * size);
+                    if k % 2 == 0 {
+                        (x, y) = ((x * 256.0).round() / 256.0, (y * 256.0).round() / 256.0);
+                    }
+                    Vertex::new(x as f32, y as f32, (1.5 + unit() * 400.0) as f32, c)
+                });
+                let mut out: [_; 2] = core::array::from_fn(|_| {
+                    (
+                        std::vec![0u16; 128 * 128],
+                        std::vec![0u16; 128 * 128],
+                        Stats::default(),
+                    )
+                });
+                for (i, (cp, zp, st)) in out.iter_mut().enumerate() {
+                    let mut band = ColorBand::<Rgb565>::band(cp, 128, 0, 128).unwrap();
+                    let mut depth = DepthBuffer::band(zp, 128, 0, 128).unwrap();
+                    depth.clear();
+                    *st = if i == 0 {
+                        r.draw(&mut band, &mut depth, &v).unwrap()
+                    } else {
+                        r.draw_memo(&mut band, &mut depth, &v, &mut Liar).unwrap()
+                    };
+                }
+                assert!(out[0] == out[1], "triangle {k}");
+                drawn += u32::from(out[0].2.written > 0);
+            }
+            // Not vacuous: most of them write pixels (the rest are back faces or slivers between centres).
+            assert!(drawn >= 80, "{drawn}");
+        }
+        check::<crate::recip::Fast>();
+        check::<crate::recip::FastDiv>();
+    }
 
     /// Both ways to the depth-grid plane's `T` at the snapped vertices ([`t_at_snapped_narrow`], and
     /// [`t_at_snapped_wide`] where it declines) stay within their stated bound, `T_min 2^-35`, of the exact value

@@ -811,11 +811,11 @@ pub fn run_all_cached<R: SpanRecip, C: Counter>(
 }
 
 /// Triangles a board's W4 plane cache holds ([`wraster::mesh::PlaneCache`]): those that reach the next band, and the
-/// previous band's until the walk meets them; a full cache only computes values again. 27 is what the M0's 16 KiB
-/// leave (its deepest stack then keeps 268 bytes free, over CI's 256; 25 kept 324 and cost 1.1% more a frame). The
+/// previous band's until the walk meets them; a full cache only computes values again. 29 is what the M0's 16 KiB
+/// leave (its deepest stack then keeps 260 bytes free, over CI's 256; 27 kept 316 and cost 1.3% more a frame). The
 /// M0's W4 firmware given more RAM (its `memory.x` at 64K, run in
 /// QEMU's mps2-an386) saved 4.4%, 6.8%, 8.6%, 10.4% and 11.1% of the frame's instructions with 16, 24, 32, 48 and 96.
-pub const TORUS_CACHE: usize = 27;
+pub const TORUS_CACHE: usize = 29;
 /// The W4 plane cache of a plan's firmware (`--features plan`): the plans' runner is deeper on the stack than the
 /// default build's W4 run, and on the Cortex-M0 22 triangles keep its 256 bytes free (25 left 204).
 pub const PLAN_TORUS_CACHE: usize = 22;
