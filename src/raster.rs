@@ -496,11 +496,11 @@ impl<R: SpanRecip> Rasterizer<R> {
         depth.note_compare(cmp, write);
         // Only for a triangle with rows in the buffer (a band's draws include triangles that only come near it):
         // one that has none draws nothing either way, and both paths find that before they look at `fast_t`.
-        let (y0, y_last) = (
-            depth.y0(),
-            depth.y0().saturating_add(depth.height() as i32 - 1),
-        );
-        let in_buffer = move |p: &[Sub; 3]| {
+        let in_buffer = |p: &[Sub; 3], depth: &DepthBuffer<'_>| {
+            let (y0, y_last) = (
+                depth.y0(),
+                depth.y0().saturating_add(depth.height() as i32 - 1),
+            );
             let (first, last) = rows_of(p);
             (first <= y_last && last >= y0).then_some(last)
         };
@@ -511,7 +511,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         let (mut taken, mut kept_row) = (None, None);
         let (mut s, te) = if M::KEEPS {
             self.setup_snapped_first(v, |p| {
-                kept_row = in_buffer(p);
+                kept_row = in_buffer(p, depth);
                 if kept_row.is_some() {
                     taken = memo.take();
                 }
@@ -545,7 +545,7 @@ impl<R: SpanRecip> Rasterizer<R> {
             } else {
                 Self::round_t(&mut s, te);
             }
-        } else if R::FAST_W16 && !s.on_grid && in_buffer(&s.p).is_some() {
+        } else if R::FAST_W16 && !s.on_grid && in_buffer(&s.p, depth).is_some() {
             s.fast_t = self.fast_t(&s);
         }
         // (A remembered small triangle's draw reads no depth-grid values: its constants stand for them.)
@@ -554,7 +554,7 @@ impl<R: SpanRecip> Rasterizer<R> {
             && !s.on_grid
             && solved.is_none()
             && !remembered_small
-            && in_buffer(&s.p).is_some()
+            && in_buffer(&s.p, depth).is_some()
         {
             FAST_T_USED.with(|c| c.borrow_mut().push((s.p.map(|p| (p.x, p.y)), s.fast_t)));
         }
