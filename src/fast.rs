@@ -435,7 +435,30 @@ fn slope<const UP: bool>(x: i32, delta: i32) -> i32 {
 /// on the Cortex-M0).
 #[inline(always)]
 pub(crate) fn smul_wide(a: i32, b: i32) -> i64 {
-    ((smul_hi(a, b) as i64) << 32) | (a.wrapping_mul(b) as u32 as i64)
+    #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+    return smul_wide_halves(a, b);
+    #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+    return ((smul_hi(a, b) as i64) << 32) | (a.wrapping_mul(b) as u32 as i64);
+}
+
+/// [`smul_wide`] on the Cortex-M0: the unsigned product of the bits ([`mul_wide_halves`], whose low word is the
+/// signed product's), its high word corrected as in [`smul_hi_halves`] (`a b = ua ub - 2^32 (b [a < 0] + a [b < 0])`
+/// modulo `2^64`): four multiplies, not five.
+#[cfg_attr(
+    not(all(target_arch = "arm", not(target_has_atomic = "32"))),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn smul_wide_halves(a: i32, b: i32) -> i64 {
+    let w = mul_wide_halves(a as u32, b as u32);
+    let mut hi = (w >> 32) as u32;
+    if a < 0 {
+        hi = hi.wrapping_sub(b as u32);
+    }
+    if b < 0 {
+        hi = hi.wrapping_sub(a as u32);
+    }
+    ((hi as u64) << 32 | (w as u32 as u64)) as i64
 }
 
 /// `a w` modulo `2^64` (the `i64` product's bits): where the core has no 32 x 32 -> 64 multiply (the Cortex-M0), from
@@ -1534,6 +1557,7 @@ mod tests {
                 "{a} {b}"
             );
             let (sa, sb) = (a as i32, b as i32);
+            assert_eq!(smul_wide_halves(sa, sb), sa as i64 * sb as i64, "{sa} {sb}");
             assert_eq!(
                 smul_hi_halves(sa, sb),
                 ((sa as i64 * sb as i64) >> 32) as i32,
