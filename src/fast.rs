@@ -786,7 +786,7 @@ pub(crate) fn mul_wide(a: u32, b: u32) -> u64 {
 /// [`mul_wide`] from four 16 x 16 -> 32 products: with `a = ah 2^16 + al` and `b = bh 2^16 + bl`, the middle column
 /// `al bh + ah bl` (below `2^33`: its carry is bit 48 of the product), the low word `al bl + (mid << 16)` modulo
 /// `2^32` with its carry, and the high word `ah bh + (mid >> 16)` plus both carries (the product is below `2^64`, so
-/// nothing overflows). LLVM does not take this for a 64-bit product (it did the high word alone, [`mul_hi_halves`]),
+/// nothing overflows). LLVM does not take this for a 64-bit product (it did the high word's own sum, [`halves_hi`]),
 /// so no value has to be made opaque. Measured on the M0 against the high word by [`mul_hi`] and a fifth multiply
 /// for the low: W4 -1.7%, the terrain -1.3%, W3 -0.5% (the depth-grid correction and the vertices' `T` take several).
 #[cfg_attr(
