@@ -1316,6 +1316,19 @@ mod tests {
         assert!(worst <= 2f64.powf(-27.9), "{worst:e}");
     }
 
+    /// The M0's products from 16-bit halves ([`mul_hi_halves`], [`mul_wide_halves`], [`halves_hi`]) against the
+    /// `u64` product of `a` and `b`.
+    fn halves_products_are_exact(a: u32, b: u32) {
+        let exact = a as u64 * b as u64;
+        assert_eq!(mul_hi_halves(a, b), (exact >> 32) as u32, "{a} {b}");
+        assert_eq!(mul_wide_halves(a, b), exact, "{a} {b}");
+        assert_eq!(
+            halves_hi(a >> 16, a & 0xffff, b),
+            (exact >> 32) as u32,
+            "{a} {b}"
+        );
+    }
+
     /// The set-up's bit count and wide product equal `leading_zeros` and the `u64` product (all single bits, their
     /// neighbours, and a million xorshift values).
     #[test]
@@ -1325,17 +1338,7 @@ mod tests {
             assert_eq!(bits64(v), 64 - v.leading_zeros(), "{v}");
             let (a, b) = (v as u32, (v >> 32) as u32);
             assert_eq!(mul_wide(a, b), a as u64 * b as u64, "{a} {b}");
-            assert_eq!(
-                mul_hi_halves(a, b),
-                ((a as u64 * b as u64) >> 32) as u32,
-                "{a} {b}"
-            );
-            assert_eq!(mul_wide_halves(a, b), a as u64 * b as u64, "{a} {b}");
-            assert_eq!(
-                halves_hi(a >> 16, a & 0xffff, b),
-                ((a as u64 * b as u64) >> 32) as u32,
-                "{a} {b}"
-            );
+            halves_products_are_exact(a, b);
             // The wrapping product of a signed word and a 64-bit value, both signs of `a`.
             // The M0's pieces (the other cores, the host among them, take the 64-bit operations themselves).
             for a in [a as i32, v.rotate_left(17) as i32] {
@@ -1545,17 +1548,7 @@ mod tests {
             } else {
                 (rnd(&mut state) as u32, (rnd(&mut state) >> 32) as u32)
             };
-            assert_eq!(
-                mul_hi_halves(a, b),
-                ((a as u64 * b as u64) >> 32) as u32,
-                "{a} {b}"
-            );
-            assert_eq!(mul_wide_halves(a, b), a as u64 * b as u64, "{a} {b}");
-            assert_eq!(
-                halves_hi(a >> 16, a & 0xffff, b),
-                ((a as u64 * b as u64) >> 32) as u32,
-                "{a} {b}"
-            );
+            halves_products_are_exact(a, b);
             let (sa, sb) = (a as i32, b as i32);
             assert_eq!(smul_wide_halves(sa, sb), sa as i64 * sb as i64, "{sa} {sb}");
             assert_eq!(
