@@ -1066,13 +1066,14 @@ fn pixels<const UP: bool>(
     Ok(v)
 }
 
-/// The passing run from `row[0]` with a fresh reciprocal per pixel: its own function, so that its few live values
+/// The passing run from the cursor's pixel with a fresh reciprocal per pixel: its own function, so that its few live values
 /// (`v`, its step, the row, the code's rounding and shift) stay in registers. `tau` leaving its binade is handled here
 /// (`v`, `dv` and `lz` renormalised, the code's shift and rounding taken again) where the next binade does not chain
 /// either: always downward (renormalising doubles the step, [`chains`]), upward where the halved step is still above
 /// the bound; a run then continues across binades without returning (on the M4's W1, 642 of its 835 runs ended at
 /// a binade). Returns the pixels drawn, `v`, `dv` and `lz` after them, and how it ended ([`End`]; `End::Binade` only
-/// where the next binade chains, not yet renormalised).
+/// where the next binade chains, not yet renormalised; `End::Fail` at a failing pixel or at the sentinel, which
+/// [`to_end`] tells apart).
 #[inline(never)]
 fn fresh_run<const UP: bool, S: FreshSeed>(
     mut px: Cursor<'_>,
@@ -1196,8 +1197,8 @@ struct FreshEnd {
     end: End,
 }
 
-/// The passing run from `row[0]` with the reciprocal carried from pixel to pixel (`x` the previous pixel's, `dx` its
-/// difference): the chained loop, out of line like [`fresh_run`].
+/// The passing run from the cursor's pixel with the reciprocal carried from pixel to pixel (`x` the previous pixel's,
+/// `dx` its difference): the chained loop, out of line like [`fresh_run`], ending as it does.
 #[inline(never)]
 fn chain_run<const UP: bool, S: FreshSeed>(
     mut px: Cursor<'_>,
