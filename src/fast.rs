@@ -477,7 +477,7 @@ pub(crate) fn wmul(a: i32, w: u64) -> u64 {
 
 /// The Cortex-M0 (ARMv6-M, which has no 32-bit atomics either): no 32 x 32 -> 64 multiply, and a variable 64-bit
 /// shift is a library call (`__aeabi_llsl`/`__aeabi_llsr`, some 15 instructions and a call each).
-const NO_WIDE: bool = cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
+pub(crate) const NO_WIDE: bool = cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
 
 /// `v << s` for `s < 64` (the bits shifted out lost): in 32-bit pieces on the Cortex-M0 ([`NO_WIDE`]), where
 /// set-up code shifts by a variable amount a dozen times a triangle; the 64-bit shift elsewhere.
@@ -782,6 +782,37 @@ pub(crate) fn mul_wide(a: u32, b: u32) -> u64 {
     return mul_wide_halves(a, b);
     #[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
     return ((mul_hi(a, b) as u64) << 32) | a.wrapping_mul(b) as u64;
+}
+
+/// `x k` (wrapping, so `x` may be a signed step's bits) for `k < 2^16` (a row or column offset: a span is at most a
+/// buffer row, under `2^16` pixels), without a 64-bit multiply (a library call on the Cortex-M0). There the low word's
+/// carry takes two 16-bit products instead of [`mul_wide`]'s four: with `x_lo = h 2^16 + l`,
+/// `x_lo k = h k 2^16 + l k`, so its high word is `floor((h k + floor(l k / 2^16)) / 2^16)` (floors of floors), and
+/// the sum is at most `(2^16 - 1)^2 + 2^16 - 1 < 2^32`. Measured on the M0, with [`HiFactor`]: 2.2% fewer instructions
+/// on W3 and 1.6% on W4 (the small triangles' rows and columns). The M4 takes the carry from [`mul_wide`] (one
+/// `UMULL`; the two products measured 1.6% more on W3) and adds it to the high word (0.3% fewer on W4 than the 64-bit
+/// sum, which RV32 keeps: 0.1% fewer there). Tested against the wrapping 64-bit product.
+#[inline(always)]
+pub(crate) fn mul_small(x: u64, k: u32) -> u64 {
+    debug_assert!(k < 1 << 16);
+    let (lo, hi) = (x as u32, ((x >> 32) as u32).wrapping_mul(k));
+    if cfg!(target_arch = "arm") {
+        let carry = if cfg!(target_has_atomic = "32") {
+            (mul_wide(lo, k) >> 32) as u32
+        } else {
+            carry_halves(lo, k)
+        };
+        (hi.wrapping_add(carry) as u64) << 32 | lo.wrapping_mul(k) as u64
+    } else {
+        mul_wide(lo, k).wrapping_add((hi as u64) << 32)
+    }
+}
+
+/// The high word of `lo k` for `k < 2^16` from two 16-bit products ([`mul_small`]'s Cortex-M0 way; compiled on every
+/// core, so the host tests check it).
+#[inline(always)]
+fn carry_halves(lo: u32, k: u32) -> u32 {
+    ((lo >> 16) * k + (((lo & 0xffff) * k) >> 16)) >> 16
 }
 
 /// [`mul_wide`] from four 16 x 16 -> 32 products: with `a = ah 2^16 + al` and `b = bh 2^16 + bl`, the middle column
@@ -1464,6 +1495,23 @@ mod tests {
     /// `by_65535` is within 4 units below `x 65536 / 65535` (exact in u128/i128 here), for `x` in the range the
     /// span gives it (`T` normalised to `[2^62, 2^63)`), and within `[-1, 4]` units for steps of both signs (a
     /// negative step's left-out tail is below one unit above).
+    #[test]
+    fn mul_small_is_the_wrapping_product() {
+        // Every `k` below 2^16 (the largest included) with a random `x`, and the extreme low words, where the carry's
+        // sum is largest (`(2^16 - 1)^2 + 2^16 - 1`, the bound in the doc).
+        let mut rnd = crate::xorshift(0x6D75_6C5F_736D_616C);
+        for k in 0..1u32 << 16 {
+            for x in [rnd(), u64::MAX, 0xFFFF_FFFF, 0xFFFF_0000_FFFF_FFFF, 1 << 63] {
+                let want = x.wrapping_mul(k as u64);
+                assert_eq!(mul_small(x, k), want, "{x:#x} {k}");
+                assert_eq!(
+                    carry_halves(x as u32, k) as u64,
+                    (x as u32 as u64 * k as u64) >> 32
+                );
+            }
+        }
+    }
+
     #[test]
     fn by_65535_is_within_four_units() {
         let mut s = 0xC0FF_EE00_1234_5678u64;

@@ -627,7 +627,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         let mut stats = Stats::default();
         for j in w.geom.j0..=w.j1 {
             if let Some((lo, hi)) = w.row(depth.width()) {
-                let t = w.t.at(lo as i64 - w.geom.i_ref) as u64;
+                let t = w.t.at_col(lo as i64 - w.geom.i_ref) as u64;
                 #[cfg(feature = "coarse")]
                 let (row, seg) = depth.row_and_bound(j);
                 #[cfg(not(feature = "coarse"))]
@@ -913,7 +913,7 @@ fn span<R: SpanRecip, D: DrawTarget>(
     seg: &mut [u16],
 ) -> Result<(), Error> {
     let n = row.len();
-    let last = t.wrapping_add((dt as u64).wrapping_mul(n as u64 - 1));
+    let last = crate::recip::span_last(t, dt, n as u32);
     let in_range = |v: u64| v >= ctx.t_lo && v <= ctx.t_hi;
     let (tame, smooth) = SpanWalker::classify(t, dt, n as u32);
     if R::FAST_W16

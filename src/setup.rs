@@ -700,6 +700,18 @@ impl Plane {
     pub(crate) fn at(&self, di: i64) -> i64 {
         self.row.wrapping_add(self.sx.wrapping_mul(di))
     }
+    /// [`Plane::at`] at a covered column's offset `di` from the box's left column (`0 <= di`, at most the box's width:
+    /// under `2^13` px inside the guard band). On the Cortex-M0, where `di < 2^16`, by [`crate::fast::mul_small`]:
+    /// no 64-bit multiply (a library call there; see [`crate::recip::span_last`]). The same bits either way.
+    #[inline(always)]
+    pub(crate) fn at_col(&self, di: i64) -> i64 {
+        if crate::fast::NO_WIDE && (di as u64) < 1 << 16 {
+            self.row
+                .wrapping_add(crate::fast::mul_small(self.sx as u64, di as u32) as i64)
+        } else {
+            self.at(di)
+        }
+    }
     #[inline(always)]
     pub(crate) fn next_row(&mut self) {
         self.row = self.row.wrapping_add(self.sy);

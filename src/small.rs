@@ -60,7 +60,8 @@ use crate::edge::{flat_rows, DivBound, Sub};
 #[cfg(doc)]
 use crate::fast::FAST_MAX_REL_ERROR;
 use crate::fast::{
-    bits64 as bits, fresh61, lz_small, mul_wide, shl64, shr64, smul_wide, wmul, FreshSeed, HiFactor,
+    bits64 as bits, fresh61, lz_small, mul_small, mul_wide, shl64, shr64, smul_wide, wmul,
+    FreshSeed, HiFactor,
 };
 use crate::setup::{rows_of, Setup, Stats, SUBPIXEL_BITS};
 use crate::state::{Cull, RenderState};
@@ -771,29 +772,6 @@ fn s_by_differences(
     }
     let s_min = s_max.wrapping_add(prod(area2, tp_min as i64 - tp_max as i64));
     (sr, sx, sy, (s_max, s_min))
-}
-
-/// `x k` (wrapping) for `k < 2^15` (a row or column offset inside a small triangle's box), without a 64-bit multiply
-/// (a library call on the Cortex-M0). There the low word's carry takes two 16-bit products instead of
-/// [`mul_wide`]'s four: with `x_lo = h 2^16 + l`, `x_lo k = h k 2^16 + l k` (each below `2^31`), so its high word is
-/// `floor((h k + floor(l k / 2^16)) / 2^16)` (floors of floors; the sum is below `2^32`). Measured on the M0, with
-/// [`HiFactor`]: 2.2% fewer instructions on W3 and 1.6% on W4. The M4 takes the carry from [`mul_wide`] (one
-/// `UMULL`; the two products measured 1.6% more on W3) and adds it to the high word (0.3% fewer on W4 than the 64-bit
-/// sum, which RV32 keeps: 0.1% fewer there).
-#[inline(always)]
-fn mul_small(x: u64, k: u32) -> u64 {
-    debug_assert!(k < 1 << 15);
-    let (lo, hi) = (x as u32, ((x >> 32) as u32).wrapping_mul(k));
-    if cfg!(target_arch = "arm") {
-        let carry = if cfg!(target_has_atomic = "32") {
-            (mul_wide(lo, k) >> 32) as u32
-        } else {
-            ((lo >> 16) * k + (((lo & 0xffff) * k) >> 16)) >> 16
-        };
-        (hi.wrapping_add(carry) as u64) << 32 | lo.wrapping_mul(k) as u64
-    } else {
-        mul_wide(lo, k).wrapping_add((hi as u64) << 32)
-    }
 }
 
 /// One row's `len` pixels from column `x` to the target, as one `fill_solid`.
