@@ -16,6 +16,10 @@ fn main() {
         for t in scene.tris() {
             let (r0, r1) =
                 wraster::row_range(&t).expect("standard scenes are inside the guard band");
+            // The standard scenes lie in the frame: rows from 0, `u16` (4 bytes a triangle less flash).
+            let rows =
+                |r: i32| u16::try_from(r).expect("the standard scenes' rows lie in the frame");
+            let (r0, r1) = (rows(r0), rows(r1));
             let v: Vec<String> = t
                 .iter()
                 .map(|q| {

@@ -25,8 +25,10 @@ pub struct Tri {
     pub v: [[u32; 3]; 3],
     /// RGB565.
     pub color: u16,
-    /// First and last row (inclusive) from `wraster::row_range`.
-    pub rows: (i32, i32),
+    /// First and last row (inclusive) from `wraster::row_range`: the standard scenes lie in the frame, so `u16` (the
+    /// M0's flash: 44 bytes a triangle, 48 with `i32`: 11.6 KB less over the standard scenes' 2,904 triangles; `u16`
+    /// rather than `i16`, whose load on the M0 takes no immediate offset).
+    pub rows: (u16, u16),
 }
 
 /// A baked scene.
@@ -366,7 +368,7 @@ fn run_scene_in<R: SpanRecip, C: Counter>(
         let (b0, b1) = (y0 as i32, (y0 + h) as i32 - 1);
         counter.start();
         for (k, t) in scene.tris.iter().enumerate() {
-            if t.rows.0 <= b1 && t.rows.1 >= b0 {
+            if i32::from(t.rows.0) <= b1 && i32::from(t.rows.1) >= b0 {
                 stats += frame.draw(&mut r, &mut band, &mut buf, k, t)?;
             }
         }
@@ -672,7 +674,7 @@ pub fn run_plan<
         // does).
         &mut |(b0, b1), draw| {
             for t in scene.tris {
-                if t.rows.0 <= b1 && t.rows.1 >= b0 {
+                if i32::from(t.rows.0) <= b1 && i32::from(t.rows.1) >= b0 {
                     draw(&t.vertices())?;
                 }
             }
