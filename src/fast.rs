@@ -1492,9 +1492,6 @@ mod tests {
         }
     }
 
-    /// `by_65535` is within 4 units below `x 65536 / 65535` (exact in u128/i128 here), for `x` in the range the
-    /// span gives it (`T` normalised to `[2^62, 2^63)`), and within `[-1, 4]` units for steps of both signs (a
-    /// negative step's left-out tail is below one unit above).
     #[test]
     fn mul_small_is_the_wrapping_product() {
         // Every `k` below 2^16 (the largest included) with a random `x`, and the extreme low words, where the carry's
@@ -1512,6 +1509,9 @@ mod tests {
         }
     }
 
+    /// `by_65535` is within 4 units below `x 65536 / 65535` (exact in u128/i128 here), for `x` in the range the
+    /// span gives it (`T` normalised to `[2^62, 2^63)`), and within `[-1, 4]` units for steps of both signs (a
+    /// negative step's left-out tail is below one unit above).
     #[test]
     fn by_65535_is_within_four_units() {
         let mut s = 0xC0FF_EE00_1234_5678u64;

@@ -395,7 +395,7 @@ impl SpanRecip for PrevPixel {
 
 /// `T` at the last of `len >= 1` pixels from `t0` by `dt`, modulo `2^64` (the walk's own wrapping values). On the
 /// Cortex-M0, for a span of a buffer row (under `2^16` pixels), by [`crate::fast::mul_small`]: no 64-bit multiply (a
-/// library call there; with [`crate::setup::Plane::at_col`], measured M0 W2 -1.4%, W1 -0.5%). The same bits as the
+/// library call there; with [`crate::setup::Plane::at_col`], measured M0 W2 -1.4%, W1 -0.5% in single-scene builds). The same bits as the
 /// wrapping 64-bit product, which the other cores keep (one `UMULL` and two `MLA` on the M4: no fewer).
 #[inline(always)]
 pub(crate) fn span_last(t0: u64, dt: i64, len: u32) -> u64 {
