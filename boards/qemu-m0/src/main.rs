@@ -45,10 +45,11 @@ const BAND_ROWS: usize = 4;
 const PIXELS: usize = WIDTH as usize * BAND_ROWS;
 const _: () = assert!((HEIGHT as usize).is_multiple_of(BAND_ROWS));
 
-/// The standard scenes' plane cache on this board: 86 triangles (2,432 bytes) leave the deepest stack 284 bytes free
-/// (CI fails under 256), and hold W3's triangles across a band's edge (64, the other boards' `SCENE_CACHE`, did not:
-/// W3 0.9% and the terrain 1.9% more instructions; 84 cost W3 0.25% more than 86). 64 with `--features coarse`, whose bound takes 640 bytes: 500
-/// bytes free (CI checks that build too).
+/// The standard scenes' plane cache on this board: 86 triangles (2,432 bytes), which hold W3's triangles across a
+/// band's edge (64, the other boards' `SCENE_CACHE`, did not: W3 0.9% and the terrain 1.9% more instructions; 84 cost
+/// W3 0.25% more than 86; 112 saved nothing more: the terrain 0.06%). The deepest stack keeps 996 bytes free since
+/// the bench lines are written out of line (292 before; CI fails under 256). 64 with `--features coarse`, whose bound
+/// takes 640 bytes: 1,332 bytes free with `size-probe` (CI checks that build too).
 #[cfg(not(feature = "torus"))]
 type SceneCache = wraster::mesh::PlaneCache<
     {
@@ -128,10 +129,8 @@ fn band_overhead(
 }
 
 /// W4's plane cache on this board (see `main`).
-#[cfg(all(feature = "torus", not(feature = "cull")))]
+#[cfg(feature = "torus")]
 type Cache = wraster::mesh::PlaneCache<{ wraster_board::TORUS_CACHE }>;
-#[cfg(feature = "cull")]
-type Cache = wraster::mesh::PlaneCache<22>;
 
 /// `--features torus`: W4 only (the rotating torus through the mesh path), with each strategy.
 #[cfg(all(feature = "torus", not(feature = "plan")))]
@@ -147,9 +146,9 @@ fn main() -> ! {
     // The row bins (`Rasterizer::bin_mesh`, a byte per triangle): each of the 60 bands sets up only the triangles
     // that can reach it.
     static mut BINS: [u8; TRIANGLES] = [0; TRIANGLES];
-    // The plane cache (`wraster::mesh::PlaneCache`, 29 triangles, 840 bytes): a triangle reaching several bands has
-    // its depth-grid values computed once a frame, not in each band. 22 in the `cull` build, which LLVM inlines
-    // differently: the stack keeps 256 bytes free in both.
+    // The plane cache (`wraster::mesh::PlaneCache`, 38 triangles, 1,088 bytes): a triangle reaching several bands
+    // has its depth-grid values computed once a frame, not in each band. The same in the `cull` build: the stack
+    // keeps 256 bytes free in both (`wraster_board::TORUS_CACHE`).
     static mut CACHE: Cache = Cache::new();
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
