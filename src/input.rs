@@ -139,6 +139,25 @@ fn snap_bits(v: f32) -> Result<(i32, bool), Error> {
     }
 }
 
+/// [`snap_bits`] of `x` and `y`, and whether both were exact, their high words tested together (the flags are 0 and
+/// 1, the errors 2 and 3): one branch where both snap, instead of a match on each `Result`. `x`'s error first, as
+/// `snap_exact(x)?` then `snap_exact(y)?` report them. Measured on the M0's W3: about 50 instructions fewer a
+/// triangle.
+#[inline(always)]
+fn snap_pair(x: f32, y: f32) -> Result<(i32, i32, bool), Error> {
+    let (wx, wy) = (snap_packed(x), snap_packed(y));
+    let (hx, hy) = ((wx >> 32) as u32, (wy >> 32) as u32);
+    if hx | hy < 2 {
+        return Ok((wx as u32 as i32, wy as u32 as i32, hx & hy != 0));
+    }
+    let h = if hx >= 2 { hx } else { hy };
+    Err(if h == SNAP_NON_FINITE {
+        Error::NonFinite
+    } else {
+        Error::OutOfGuardBand
+    })
+}
+
 /// [`snap_packed`]'s high word for NaN and infinities (`OutOfGuardBand` is 3).
 const SNAP_NON_FINITE: u32 = 2;
 
@@ -234,6 +253,9 @@ impl<C: Copy> VertexInput for Vertex<C> {
     }
     #[inline]
     fn snapped_exact(&self) -> Result<(i32, i32, bool), Error> {
+        if !HARD_FLOAT {
+            return snap_pair(self.x, self.y);
+        }
         let ((x, ex), (y, ey)) = (snap_exact(self.x)?, snap_exact(self.y)?);
         Ok((x, y, ex & ey))
     }
@@ -383,6 +405,32 @@ mod tests {
             s ^= s << 5;
             check(f32::from_bits(s));
             check(f32::from_bits(s & 0x45ff_ffff));
+        }
+    }
+
+    /// The cores without an FPU snap a vertex with [`snap_pair`]: the values, the joint exactness flag and the
+    /// first error as the two snaps one after the other give them, on every pair of a set of values that covers each
+    /// outcome (exact, inexact, beyond the guard band, NaN and infinities, both signs).
+    #[test]
+    fn a_pair_snaps_as_its_two_coordinates() {
+        let mut values = std::vec::Vec::new();
+        each_bit_class(2_000, 0x1234_5679, |v| values.push(v));
+        values.extend([
+            0.5f32,
+            1.0 / 256.0,
+            3.0 / 512.0,
+            4095.99,
+            -4096.0,
+            4096.0,
+            f32::NAN,
+            f32::INFINITY,
+        ]);
+        for &x in &values {
+            for &y in values.iter().step_by(7) {
+                let want = snap_exact(x)
+                    .and_then(|(sx, ex)| snap_exact(y).map(|(sy, ey)| (sx, sy, ex & ey)));
+                assert_eq!(snap_pair(x, y), want, "{x:e} {y:e}");
+            }
         }
     }
 
