@@ -47,6 +47,21 @@ pub(crate) fn round_shift(m: u64, e: i32) -> u64 {
     }
 }
 
+/// [`round_shift`] for a product the caller knows to be below `2^63` (`e < 64 - bits(m)` where `e >= 0`): the same
+/// value without the saturation's bit count, which on the cores without CLZ (the Cortex-M0, RV32IMAC) is a table
+/// look-up of some 25 instructions. The set-up's `T` ([`crate::Rasterizer`]'s `round_t`) is one: its fraction bits
+/// `F = 61 - max_k bits(T_k)` put every `T_k 2^F` below `2^61`. Measured on the M0's W3: 6,000 calls, 53 instructions
+/// each before.
+#[inline]
+pub(crate) fn round_shift_fits(m: u64, e: i32) -> u64 {
+    debug_assert!(e < 0 || m == 0 || e < 64 - crate::fast::bits64(m) as i32);
+    if (e as u32) < 64 {
+        crate::fast::shl64(m, e as u32)
+    } else {
+        round_shift(m, e)
+    }
+}
+
 /// `v * 2^frac_bits` rounded to nearest (ties to even), for `|v| <= limit`; `Err(true)` outside, `Err(false)` for
 /// non-finite. The general 64-bit conversion, kept as the reference the 32-bit snap (`input::snap`) is tested against.
 #[cfg(test)]
@@ -324,6 +339,28 @@ mod tests {
         assert_eq!(round_shift(1 << 62, -63), 0); // 1/2, ties to even
         assert_eq!(round_shift((1 << 62) + 1, -63), 1);
         assert_eq!(round_shift(u64::MAX, -63), 2);
+    }
+
+    /// [`round_shift_fits`] is [`round_shift`] wherever its contract holds (`m 2^e < 2^63`), on every shift from
+    /// `2^-80` up and every mantissa width.
+    #[test]
+    fn round_shift_fits_is_round_shift_below_its_bound() {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut left = 0;
+        for k in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let m = x >> (k % 64);
+            for e in -80..64 {
+                let fits = e < 0 || m == 0 || e < m.leading_zeros() as i32;
+                if fits {
+                    left += usize::from(e >= 0);
+                    assert_eq!(round_shift_fits(m, e), round_shift(m, e), "{m} {e}");
+                }
+            }
+        }
+        assert!(left > 1_000_000, "{left}");
     }
 
     #[test]

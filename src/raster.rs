@@ -168,7 +168,8 @@ impl<R: WSpan> Rasterizer<R> {
     #[inline(always)]
     pub(crate) fn round_t<const N: usize>(s: &mut Setup<N>, te: [i32; N]) {
         for (t, e) in s.t.iter_mut().zip(te) {
-            *t = round_shift(*t as u64, e + s.frac as i32) as i64;
+            // Below 2^61 (`frac = 61 - max_k bits(T_k)`): no saturation to test.
+            *t = crate::fixed::round_shift_fits(*t as u64, e + s.frac as i32) as i64;
         }
     }
 
