@@ -50,8 +50,8 @@ pub(crate) fn round_shift(m: u64, e: i32) -> u64 {
 /// [`round_shift`] for a product the caller knows to be below `2^63` (`e < 64 - bits(m)` where `e >= 0`): the same
 /// value without the saturation's bit count, which on the cores without CLZ (the Cortex-M0, RV32IMAC) is a table
 /// look-up of some 25 instructions. The set-up's `T` ([`crate::Rasterizer`]'s `round_t`) is one: its fraction bits
-/// `F = 61 - max_k bits(T_k)` put every `T_k 2^F` below `2^61`. Measured on the M0's W3: 6,000 calls, 53 instructions
-/// each before.
+/// `F = 61 - max_k bits(T_k)` put every `T_k 2^F` below `2^61`. Measured on the M0's W3 (single-scene build, commit
+/// aa8bafb): 6,000 calls of 53 instructions before; 6,714.9 -> 6,599.2 instructions a triangle.
 #[inline]
 pub(crate) fn round_shift_fits(m: u64, e: i32) -> u64 {
     debug_assert!(e < 0 || m == 0 || e < 64 - crate::fast::bits64(m) as i32);

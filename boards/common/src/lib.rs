@@ -830,7 +830,8 @@ fn scene_line(
 /// leave (its deepest stack then keeps 300 bytes free in the torus build and 284 in the `cull` build, over CI's 256;
 /// 39 left the `cull` build 252) since the frame loop keeps its transform, its camera and its lines out of line
 /// ([`torus_frame`], [`torus_view`], [`torus_line`]: 29 slots were all it had room for before). Measured on the M0's
-/// W4 (default `Fast`): 9,073,718 instructions a frame with 29, 8,693,976 with 38, 8,667,342 with 39. The M0's W4
+/// W4 (default `Fast`, commit 1f8a1ba's draw code): 9,073,718 instructions a frame with 29, 8,693,976 with 38,
+/// 8,667,342 with 39. The M0's W4
 /// firmware given more RAM (its `memory.x` at 64K, run in QEMU's mps2-an386) saved 4.4%, 6.8%, 8.6%, 10.4% and 11.1%
 /// of the frame's instructions with 16, 24, 32, 48 and 96 (measured with an earlier commit's code).
 pub const TORUS_CACHE: usize = 38;
