@@ -21,10 +21,10 @@ import glob, os, re, subprocess, sys
 ROOT = os.path.realpath(os.path.join(os.path.dirname(__file__), '..', '..'))
 BOARDS = {'m4': ('qemu-m4', 'thumbv7em-none-eabihf', 'wraster-qemu-m4'),
           'm0': ('qemu-m0', 'thumbv6m-none-eabi', 'wraster-qemu-m0')}
-# The boards' own depth buffers (bytes): the M4's whole W16 frame; the M0's 8-row W16 bands (4 rows for the torus,
-# whose 512 transformed vertices take the rest of its 16 KiB).
+# The boards' own depth buffers (bytes): the M4's whole W16 frame; the M0's 8-row W16 bands (6 rows for the torus,
+# whose 512 transformed vertices take most of its 16 KiB; its colour band holds palette indices, two to a byte).
 DEFAULT_DEPTH = {('m4', False): 320 * 240 * 2, ('m0', False): 320 * 8 * 2, ('m4', True): 320 * 240 * 2,
-                 ('m0', True): 320 * 4 * 2}
+                 ('m0', True): 320 * 6 * 2}
 
 
 def field(line, key):

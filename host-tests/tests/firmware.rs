@@ -42,8 +42,8 @@ fn boards_render_the_hosts_frames_bit_for_bit() {
     // transform): the boards run it on W4 only.
     scene_hashes::<FastDivInt>(&mut host);
 
-    // Each board builds the standard scenes (four strategies), and W4 with `--features torus` (on the M0, 60 bands:
-    // its vertex store takes 6 KiB of the 16): the four, and on RV32 its default `FastDivInt` too, which the M4 and
+    // Each board builds the standard scenes (four strategies), and W4 with `--features torus` (on the M0, 40 bands of
+    // palette indices, hashed as their RGB565 colours: its vertex store takes 6 KiB of the 16): the four, and on RV32 its default `FastDivInt` too, which the M4 and
     // M0 run in their `cull` builds.
     let std_lines = host
         .keys()
@@ -54,8 +54,8 @@ fn boards_render_the_hosts_frames_bit_for_bit() {
         ("qemu-m4", &["torus"][..], 1, 4),
         ("qemu-m4", &["cull"][..], 1, 5),
         ("qemu-m0", &[][..], 30, std_lines),
-        ("qemu-m0", &["torus"][..], 60, 4),
-        ("qemu-m0", &["cull"][..], 60, 5),
+        ("qemu-m0", &["torus"][..], 40, 4),
+        ("qemu-m0", &["cull"][..], 40, 5),
         ("qemu-rv32", &[][..], 1, std_lines),
         ("qemu-rv32", &["torus"][..], 1, 5),
     ] {

@@ -4,7 +4,7 @@
 //!
 //! Hash: FNV-1a 64 over the frame's rows in order; for each row the colour of every pixel (RGB565, u16 little-endian)
 //! then the depth of every pixel (W16, u16 little-endian). The host computes the same (host-tests/tests/firmware.rs).
-#![no_std]
+#![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 
 use core::fmt::Write;
@@ -593,7 +593,7 @@ pub fn run_plan<
                 // The frame cached or as it is: two types, one call each.
                 macro_rules! in_bands {
                     ($frame:expr) => {
-                        mesh_frame_in_bands(
+                        mesh_frame_in_bands::<_, Rgb565, _>(
                             &mut r,
                             $frame,
                             plan.band_rows,
@@ -826,15 +826,14 @@ fn scene_line(
 }
 
 /// Triangles a board's W4 plane cache holds ([`wraster::mesh::PlaneCache`]): those that reach the next band, and the
-/// previous band's until the walk meets them; a full cache only computes values again. 38 is what the M0's 16 KiB
-/// leave (its deepest stack then keeps 300 bytes free in the torus build and 284 in the `cull` build, over CI's 256;
-/// 39 left the `cull` build 252) since the frame loop keeps its transform, its camera and its lines out of line
-/// ([`torus_frame`], [`torus_view`], [`torus_line`]: 29 slots were all it had room for before). Measured on the M0's
-/// W4 (default `Fast`, commit 1f8a1ba's draw code): 9,073,718 instructions a frame with 29, 8,693,976 with 38,
-/// 8,667,342 with 39. The M0's W4
-/// firmware given more RAM (its `memory.x` at 64K, run in QEMU's mps2-an386) saved 4.4%, 6.8%, 8.6%, 10.4% and 11.1%
-/// of the frame's instructions with 16, 24, 32, 48 and 96 (measured with an earlier commit's code).
-pub const TORUS_CACHE: usize = 38;
+/// previous band's until the walk meets them; a full cache only computes values again. 50 is what the M0's 16 KiB
+/// leave beside its 6-row bands of palette indices (its deepest stack then keeps 284 bytes free in the torus build
+/// and 276 in the `cull` build, over CI's 256), since the frame loop keeps its transform, its camera and its lines out
+/// of line (`torus_frame`, `torus_view`, `torus_line`). Measured on the M0's W4 (default `Fast` alone, commit
+/// 2124873's draw code, its firmware given more RAM: `memory.x` at 4M, run in QEMU's mps2-an386, the same
+/// instructions): 5-row bands, 7,907,768 instructions a frame with 38, 7,747,448 with 49, 7,678,228 with 64,
+/// 7,643,562 with 100; 4-row bands (RGB565), 8,396,060 with 38 and 8,131,556 with 64.
+pub const TORUS_CACHE: usize = 50;
 /// The W4 plane cache of a plan's firmware (`--features plan`): the plans' runner is deeper on the stack than the
 /// default build's W4 run, and on the Cortex-M0 22 triangles keep its 256 bytes free (25 left 204).
 pub const PLAN_TORUS_CACHE: usize = 22;
@@ -843,26 +842,284 @@ pub type TorusCache = wraster::mesh::PlaneCache<TORUS_CACHE>;
 
 /// How a board's W4 run keeps its frames: as they are (`()`, for a frame in one band: nothing to cache) or with a
 /// plane cache ([`TorusCache`]). A type, not a value: a board links only the draw it uses.
-pub trait TorusFrames {
+pub trait TorusFrames<P: Copy = Rgb565> {
     /// The frame drawn.
-    type Frame<'a>: wraster::mesh::DrawFrame<'a, Rgb565>
+    type Frame<'a>: wraster::mesh::DrawFrame<'a, P>
     where
-        Self: 'a;
+        Self: 'a,
+        P: 'a;
     /// Frame `f` as drawn.
-    fn attach<'a>(&'a mut self, f: MeshFrame<'a, Rgb565>) -> Self::Frame<'a>;
+    fn attach<'a>(&'a mut self, f: MeshFrame<'a, P>) -> Self::Frame<'a>;
 }
 
-impl TorusFrames for () {
-    type Frame<'a> = MeshFrame<'a, Rgb565>;
-    fn attach<'a>(&'a mut self, f: MeshFrame<'a, Rgb565>) -> MeshFrame<'a, Rgb565> {
+impl<P: Copy> TorusFrames<P> for () {
+    type Frame<'a>
+        = MeshFrame<'a, P>
+    where
+        P: 'a;
+    fn attach<'a>(&'a mut self, f: MeshFrame<'a, P>) -> MeshFrame<'a, P> {
         f
     }
 }
 
-impl<const N: usize> TorusFrames for wraster::mesh::PlaneCache<N> {
-    type Frame<'a> = wraster::mesh::CachedFrame<'a, Rgb565>;
-    fn attach<'a>(&'a mut self, f: MeshFrame<'a, Rgb565>) -> Self::Frame<'a> {
+impl<P: Copy, const N: usize> TorusFrames<P> for wraster::mesh::PlaneCache<N> {
+    type Frame<'a>
+        = wraster::mesh::CachedFrame<'a, P>
+    where
+        P: 'a;
+    fn attach<'a>(&'a mut self, f: MeshFrame<'a, P>) -> Self::Frame<'a> {
         f.with_plane_cache(self)
+    }
+}
+
+/// A palette index as a colour, turned into RGB565 by a palette as it leaves the band (for the display; here, for
+/// the hash): a scene of few colours (W4's eight and the background) then keeps half a byte a pixel ([`NibbleBand`])
+/// rather than two, which on the Cortex-M0's 16 KiB buys taller bands (its W4 build: 6 rows rather than 4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PaletteIndex(pub u8);
+
+impl embedded_graphics_core::pixelcolor::PixelColor for PaletteIndex {
+    type Raw = embedded_graphics_core::pixelcolor::raw::RawU8;
+}
+
+impl From<embedded_graphics_core::pixelcolor::raw::RawU8> for PaletteIndex {
+    fn from(r: embedded_graphics_core::pixelcolor::raw::RawU8) -> Self {
+        use embedded_graphics_core::pixelcolor::raw::RawData;
+        PaletteIndex(r.into_inner())
+    }
+}
+
+impl From<PaletteIndex> for embedded_graphics_core::pixelcolor::raw::RawU8 {
+    fn from(p: PaletteIndex) -> Self {
+        Self::new(p.0)
+    }
+}
+
+/// A band of palette indices packed two to a byte (pixel `x` of a row in byte `x / 2`, the low nibble for even `x`),
+/// a `DrawTarget` of [`PaletteIndex`] (indices below 16): W4's nine colours in half the bytes of [`PaletteIndex`]'s
+/// band, so that the Cortex-M0's W4 has 6-row bands in the RAM 5-row bands of whole bytes took. Rows `y0..y0 +
+/// height` of the frame; writes outside them, or outside the columns, are dropped.
+pub struct NibbleBand<'a> {
+    px: &'a mut [u8],
+    width: usize,
+    height: usize,
+    y0: i32,
+}
+
+impl<'a> NibbleBand<'a> {
+    /// A band of `height` rows of `width` (even) pixels from frame row `y0`: `px.len()` must be `width * height / 2`
+    /// (else [`Error::BufferSize`], as for an odd or zero size).
+    pub fn band(px: &'a mut [u8], width: u16, y0: i32, height: u16) -> Result<Self, Error> {
+        let expected = width as usize * height as usize / 2;
+        if px.len() != expected || width == 0 || height == 0 || !width.is_multiple_of(2) {
+            return Err(Error::BufferSize {
+                expected,
+                actual: px.len(),
+            });
+        }
+        Ok(NibbleBand {
+            px,
+            width: width as usize,
+            height: height as usize,
+            y0,
+        })
+    }
+
+    /// The band's bytes, row by row (`width / 2` a row).
+    pub fn bytes(&self) -> &[u8] {
+        self.px
+    }
+
+    /// Row `y` of the frame as the band's bytes (`None` outside the band).
+    #[inline(always)]
+    fn row_mut(&mut self, y: i32) -> Option<&mut [u8]> {
+        let r = y.wrapping_sub(self.y0) as u32 as usize; // below y0: wraps above `height`
+        let stride = self.width / 2;
+        if r < self.height {
+            self.px.get_mut(r * stride..(r + 1) * stride)
+        } else {
+            None
+        }
+    }
+
+    /// Columns `x0..x1` (inside the row) of `row` set to the index `v` (below 16).
+    #[inline(always)]
+    fn fill_row(row: &mut [u8], x0: usize, x1: usize, v: u8) {
+        let mut x = x0;
+        if x & 1 == 1 && x < x1 {
+            if let Some(b) = row.get_mut(x / 2) {
+                *b = (*b & 0x0f) | v << 4;
+            }
+            x += 1;
+        }
+        let pairs_end = x1 & !1;
+        if x < pairs_end {
+            if let Some(bytes) = row.get_mut(x / 2..pairs_end / 2) {
+                bytes.fill(v | v << 4);
+            }
+            x = pairs_end;
+        }
+        if x < x1 {
+            if let Some(b) = row.get_mut(x / 2) {
+                *b = (*b & 0xf0) | v;
+            }
+        }
+    }
+}
+
+impl embedded_graphics_core::geometry::Dimensions for NibbleBand<'_> {
+    /// The band's own rows.
+    fn bounding_box(&self) -> embedded_graphics_core::primitives::Rectangle {
+        embedded_graphics_core::primitives::Rectangle::new(
+            embedded_graphics_core::geometry::Point::new(0, self.y0),
+            embedded_graphics_core::geometry::Size::new(self.width as u32, self.height as u32),
+        )
+    }
+}
+
+impl embedded_graphics_core::draw_target::DrawTarget for NibbleBand<'_> {
+    type Color = PaletteIndex;
+    type Error = core::convert::Infallible;
+
+    fn draw_iter<I: IntoIterator<Item = embedded_graphics_core::Pixel<PaletteIndex>>>(
+        &mut self,
+        pixels: I,
+    ) -> Result<(), Self::Error> {
+        let width = self.width;
+        for embedded_graphics_core::Pixel(p, c) in pixels {
+            if let (Some(row), Ok(x)) = (self.row_mut(p.y), usize::try_from(p.x)) {
+                if x < width {
+                    Self::fill_row(row, x, x + 1, c.0 & 15);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Each row of the rectangle clipped to the band: a lone first or last nibble, the bytes between filled whole.
+    #[inline(always)]
+    fn fill_solid(
+        &mut self,
+        area: &embedded_graphics_core::primitives::Rectangle,
+        color: PaletteIndex,
+    ) -> Result<(), Self::Error> {
+        let (p, size) = (area.top_left, area.size);
+        let x0 = p.x.max(0) as usize;
+        let x1 = (p.x.saturating_add_unsigned(size.width).max(0) as usize).min(self.width);
+        if x0 < x1 {
+            for y in p.y..p.y.saturating_add_unsigned(size.height) {
+                if let Some(row) = self.row_mut(y) {
+                    Self::fill_row(row, x0, x1, color.0 & 15);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn clear(&mut self, color: PaletteIndex) -> Result<(), Self::Error> {
+        let v = color.0 & 15;
+        self.px.fill(v | v << 4);
+        Ok(())
+    }
+}
+
+/// W4's palette by index: 0 the background (the cleared band), `1 + k mod 8` triangle `k`'s
+/// (`wraster::scenes::torus::PALETTE`).
+pub const TORUS_PALETTE: [u16; 9] = {
+    let (mut p, mut k) = ([0u16; 9], 0);
+    while k < 8 {
+        p[k + 1] = wraster::scenes::torus::PALETTE[k];
+        k += 1;
+    }
+    p
+};
+
+/// W4's face colours as indices into [`TORUS_PALETTE`] (flash).
+pub static TORUS_FACE_INDICES: [PaletteIndex; wraster::scenes::torus::TRIANGLES] = {
+    let (mut f, mut k) = ([PaletteIndex(0); wraster::scenes::torus::TRIANGLES], 0);
+    while k < f.len() {
+        f[k] = PaletteIndex(1 + (k % 8) as u8);
+        k += 1;
+    }
+    f
+};
+
+/// How W4's frames keep their colour band: RGB565 in a [`ColorBand`] (`Rgb565`), or palette indices packed two to a
+/// byte in a [`NibbleBand`] ([`Nibbles`]). Either way a band hashes as its RGB565 pixels, so the frames' hashes are
+/// the same. A type, not a value: a board links only the band it uses.
+pub trait TorusTarget {
+    /// The colour drawn.
+    type Color: embedded_graphics_core::pixelcolor::PixelColor + 'static;
+    /// The band's storage element.
+    type Store: bytemuck::Pod;
+    /// The band as a draw target.
+    type Band<'a>: embedded_graphics_core::draw_target::DrawTarget<Color = Self::Color>;
+    /// Storage elements of a band of `rows` rows.
+    fn len(rows: u16) -> usize;
+    /// The band of frame rows `y0..y0 + rows` in `px` (at least [`TorusTarget::len`] long), cleared to the
+    /// background.
+    fn band(px: &mut [Self::Store], y0: i32, rows: u16) -> Result<Self::Band<'_>, Error>;
+    /// Triangle `k`'s colour, element `k`.
+    fn faces() -> &'static [Self::Color];
+    /// Hashes the band's row `r` (`WIDTH` pixels) as its RGB565 words.
+    fn hash_row(hash: &mut Fnv, px: &[Self::Store], r: usize);
+}
+
+impl TorusTarget for Rgb565 {
+    type Color = Rgb565;
+    type Store = u16;
+    type Band<'a> = ColorBand<'a, Rgb565>;
+    fn len(rows: u16) -> usize {
+        WIDTH as usize * rows as usize
+    }
+    fn band(px: &mut [u16], y0: i32, rows: u16) -> Result<ColorBand<'_, Rgb565>, Error> {
+        let px = cleared_front(px, Self::len(rows))?;
+        ColorBand::band(px, WIDTH, y0, rows)
+    }
+    fn faces() -> &'static [Rgb565] {
+        &TORUS_COLORS
+    }
+    fn hash_row(hash: &mut Fnv, px: &[u16], r: usize) {
+        let w = WIDTH as usize;
+        hash.words(px.get(r * w..(r + 1) * w).unwrap_or(&[]));
+    }
+}
+
+/// The first `n` elements of a band's storage, zeroed (the background), or [`Error::BufferSize`].
+fn cleared_front<T: bytemuck::Pod>(px: &mut [T], n: usize) -> Result<&mut [T], Error> {
+    let actual = px.len();
+    let px = px.get_mut(..n).ok_or(Error::BufferSize {
+        expected: n,
+        actual,
+    })?;
+    px.fill(bytemuck::Zeroable::zeroed());
+    Ok(px)
+}
+
+/// [`TorusTarget`]'s band of palette indices, two to a byte ([`NibbleBand`], [`TORUS_PALETTE`]).
+pub struct Nibbles;
+
+impl TorusTarget for Nibbles {
+    type Color = PaletteIndex;
+    type Store = u8;
+    type Band<'a> = NibbleBand<'a>;
+    fn len(rows: u16) -> usize {
+        WIDTH as usize * rows as usize / 2
+    }
+    fn band(px: &mut [u8], y0: i32, rows: u16) -> Result<NibbleBand<'_>, Error> {
+        let px = cleared_front(px, Self::len(rows))?;
+        NibbleBand::band(px, WIDTH, y0, rows)
+    }
+    fn faces() -> &'static [PaletteIndex] {
+        &TORUS_FACE_INDICES
+    }
+    fn hash_row(hash: &mut Fnv, px: &[u8], r: usize) {
+        let stride = WIDTH as usize / 2;
+        for &b in px.get(r * stride..(r + 1) * stride).unwrap_or(&[]) {
+            for i in [b & 15, b >> 4] {
+                hash.words(&[TORUS_PALETTE.get(i as usize).copied().unwrap_or(0)]);
+            }
+        }
     }
 }
 
@@ -898,36 +1155,36 @@ pub fn run_torus<R: SpanRecip, C: Counter>(
 /// `on_band` (first row, pixels). Returns the draws' instructions (not the clears or the hash) and the bands.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn mesh_frame_in_bands<'a, R: SpanRecip, C: Counter>(
+fn mesh_frame_in_bands<'a, R: SpanRecip, T: TorusTarget, C: Counter>(
     r: &mut Rasterizer<R>,
-    frame: &impl wraster::mesh::DrawFrame<'a, Rgb565>,
+    frame: &impl wraster::mesh::DrawFrame<'a, T::Color>,
     band_h: u16,
-    color: &mut [u16],
+    color: &mut [T::Store],
     depth: &mut [u16],
     bound: &mut [u16],
     counter: &mut C,
     stats: &mut Stats,
     hash: &mut Fnv,
-    on_band: &mut impl FnMut(u16, &[u16]),
+    on_band: &mut impl FnMut(u16, &[T::Store]),
 ) -> Result<(u64, u32), Error> {
     let (mut instructions, mut bands) = (0u64, 0u32);
     let w = WIDTH as usize;
     let mut y0 = 0u16;
     while y0 < HEIGHT {
         let h = band_h.min(HEIGHT - y0);
-        let n = w * h as usize;
-        let (color, depth) = (&mut color[..n], &mut depth[..n]);
-        color.fill(0);
+        let depth = &mut depth[..w * h as usize];
         let buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
         let mut buf = with_bound(buf, &mut *bound, h)?;
         buf.clear();
-        let mut band = ColorBand::<Rgb565>::band(color, WIDTH, y0 as i32, h)?;
+        let mut band = T::band(color, y0 as i32, h)?;
         counter.start();
         let s = r.draw_mesh_frame(&mut band, &mut buf, frame);
         instructions += counter.stop();
+        drop(band);
         *stats += s?;
-        hash_band(hash, band.pixels(), buf.data(), w);
-        on_band(y0, band.pixels());
+        let color = &color[..T::len(h)];
+        hash_band::<T>(hash, color, buf.data(), h);
+        on_band(y0, color);
         bands += 1;
         y0 += h;
     }
@@ -937,9 +1194,13 @@ fn mesh_frame_in_bands<'a, R: SpanRecip, C: Counter>(
 /// Hashes a band's rows (`w` pixels each): each row's colours, then its depths. Out of line: its loop's registers
 /// are then not spilled to the stack under the frame's draws (the Cortex-M0's plane cache is sized by that stack).
 #[inline(never)]
-fn hash_band(hash: &mut Fnv, colors: &[u16], depths: &[u16], w: usize) {
-    for (c, d) in colors.chunks_exact(w).zip(depths.chunks_exact(w)) {
-        hash.words(c);
+fn hash_band<T: TorusTarget>(hash: &mut Fnv, colors: &[T::Store], depths: &[u16], rows: u16) {
+    for (r, d) in depths
+        .chunks_exact(WIDTH as usize)
+        .take(rows as usize)
+        .enumerate()
+    {
+        T::hash_row(hash, colors, r);
         hash.words(d);
     }
 }
@@ -957,7 +1218,7 @@ pub fn run_torus_with<R: SpanRecip, C: Counter>(
     frames: core::ops::Range<usize>,
     on_band: impl FnMut(u16, &[u16]),
 ) -> Result<Run, Error> {
-    run_torus_bounded::<R, C>(
+    run_torus_bounded::<R, Rgb565, C>(
         color,
         depth,
         &mut [],
@@ -972,16 +1233,16 @@ pub fn run_torus_with<R: SpanRecip, C: Counter>(
 
 /// [`run_torus_with`], each band's depth buffer keeping a coarse bound in `bound` (feature `coarse`; empty: none).
 #[allow(clippy::too_many_arguments)]
-pub fn run_torus_bounded<R: SpanRecip, C: Counter>(
-    color: &mut [u16],
+pub fn run_torus_bounded<R: SpanRecip, T: TorusTarget, C: Counter>(
+    color: &mut [T::Store],
     depth: &mut [u16],
     bound: &mut [u16],
     verts: &mut [Projected],
     bins: &mut [u8],
-    cache: &mut impl TorusFrames,
+    cache: &mut impl TorusFrames<T::Color>,
     counter: &mut C,
     frames: core::ops::Range<usize>,
-    mut on_band: impl FnMut(u16, &[u16]),
+    mut on_band: impl FnMut(u16, &[T::Store]),
 ) -> Result<Run, Error> {
     use wraster::scenes::torus;
     let band_h = (depth.len() / WIDTH as usize) as u16;
@@ -990,7 +1251,7 @@ pub fn run_torus_bounded<R: SpanRecip, C: Counter>(
     let mesh = Mesh {
         positions: &TORUS_POSITIONS,
         indices: &TORUS_INDICES,
-        colors: Colors::PerFace(&TORUS_COLORS),
+        colors: Colors::PerFace(T::faces()),
     };
     let vp = Viewport::new(0.0, 0.0, WIDTH as f32, HEIGHT as f32);
     let mut stats = Stats::default();
@@ -1006,7 +1267,7 @@ pub fn run_torus_bounded<R: SpanRecip, C: Counter>(
             }
             Err(e) => return Err(*e),
         };
-        let (i, b) = mesh_frame_in_bands(
+        let (i, b) = mesh_frame_in_bands::<_, T, _>(
             &mut r,
             frame,
             band_h,
@@ -1047,11 +1308,11 @@ fn torus_view() -> Result<(wraster::RenderState, wraster::projection::Mat4), Err
 /// under its draws, which on the Cortex-M0 set how many triangles its plane cache can hold.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn torus_frame<'a, R: SpanRecip, C: Counter, T: TorusFrames>(
+fn torus_frame<'a, R: SpanRecip, P: Copy, C: Counter, T: TorusFrames<P>>(
     r: &Rasterizer<R>,
     to_clip: &wraster::projection::Mat4,
     k: usize,
-    mesh: &Mesh<'a, Rgb565>,
+    mesh: &Mesh<'a, P>,
     vp: &Viewport,
     verts: &'a mut [Projected],
     bins: &'a mut [u8],
@@ -1115,12 +1376,32 @@ pub fn run_torus_line_bounded<R: SpanRecip, C: Counter>(
     bins: &mut [u8],
     cache: &mut impl TorusFrames,
     counter: &mut C,
+    print: impl FnMut(core::fmt::Arguments<'_>),
+) -> bool {
+    run_torus_line_in::<R, Rgb565, C>(
+        board, core, color, depth, bound, verts, bins, cache, counter, print,
+    )
+}
+
+/// [`run_torus_line_bounded`] with any [`TorusTarget`]: `color` holds its band's storage (half a byte a pixel for
+/// [`Nibbles`]); the band's height is `depth`'s rows.
+#[allow(clippy::too_many_arguments)]
+pub fn run_torus_line_in<R: SpanRecip, T: TorusTarget, C: Counter>(
+    board: &str,
+    core: &str,
+    color: &mut [T::Store],
+    depth: &mut [u16],
+    bound: &mut [u16],
+    verts: &mut [Projected],
+    bins: &mut [u8],
+    cache: &mut impl TorusFrames<T::Color>,
+    counter: &mut C,
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
     if option_env!("ONLY").is_some_and(|o| o != "torus") {
         return true;
     }
-    match run_torus_bounded::<R, C>(
+    match run_torus_bounded::<R, T, C>(
         color,
         depth,
         bound,
@@ -1268,4 +1549,91 @@ pub fn bench_line_of(board: &str, core: &str, format: &str, run: &Run) -> heaple
         if run.bound { "coarse" } else { "none" }
     );
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use embedded_graphics_core::draw_target::DrawTarget;
+    use embedded_graphics_core::geometry::{Point, Size};
+    use embedded_graphics_core::primitives::Rectangle;
+
+    /// Every rectangle (inside, across every side, empty, far outside, from every column's parity) fills exactly its
+    /// pixels inside the band and keeps the rest, and `draw_iter` writes exactly the pixels inside: checked against a
+    /// model of one index a pixel, on a band 10 pixels wide and 5 rows high at frame row 7.
+    #[test]
+    fn a_nibble_band_fills_exactly_the_pixels_inside() {
+        let (w, h, y0) = (10usize, 5usize, 7i32);
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = move |n: i32| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % n as u64) as i32
+        };
+        let (mut px, mut model) = ([0u8; 25], [0u8; 50]);
+        for k in 0..5000 {
+            let v = rnd(16) as u8;
+            let mut band = NibbleBand::band(&mut px, w as u16, y0, h as u16).unwrap();
+            let (x, y) = (rnd(16) - 3, rnd(11) + y0 - 3);
+            if k % 2 == 0 {
+                let (rw, rh) = (rnd(14) as u32, rnd(4) as u32);
+                band.fill_solid(
+                    &Rectangle::new(Point::new(x, y), Size::new(rw, rh)),
+                    PaletteIndex(v),
+                )
+                .unwrap();
+                for j in y..y + rh as i32 {
+                    for i in x..x + rw as i32 {
+                        if (0..w as i32).contains(&i) && (y0..y0 + h as i32).contains(&j) {
+                            model[(j - y0) as usize * w + i as usize] = v;
+                        }
+                    }
+                }
+            } else {
+                band.draw_iter([embedded_graphics_core::Pixel(
+                    Point::new(x, y),
+                    PaletteIndex(v),
+                )])
+                .unwrap();
+                if (0..w as i32).contains(&x) && (y0..y0 + h as i32).contains(&y) {
+                    model[(y - y0) as usize * w + x as usize] = v;
+                }
+            }
+            let unpacked: Vec<u8> = px.iter().flat_map(|b| [b & 15, b >> 4]).collect();
+            assert_eq!(unpacked, model, "after step {k}");
+        }
+    }
+
+    /// A band of palette indices hashes as the RGB565 band of their palette colours (`Nibbles` against `Rgb565`):
+    /// so W4's hash is the same whichever band a board keeps.
+    #[test]
+    fn a_nibble_band_hashes_as_its_rgb565_colours() {
+        let rows = 3u16;
+        let (mut nib, mut rgb) = (vec![0u8; Nibbles::len(rows)], vec![0u16; Rgb565::len(rows)]);
+        let mut b = Nibbles::band(&mut nib, 20, rows).unwrap();
+        let mut c = Rgb565::band(&mut rgb, 20, rows).unwrap();
+        for (k, x) in (0..WIDTH as i32).step_by(7).enumerate() {
+            let i = (k % 9) as u8;
+            let r = Rectangle::new(Point::new(x, 20 + (k % 3) as i32), Size::new(5, 1));
+            b.fill_solid(&r, PaletteIndex(i)).unwrap();
+            c.fill_solid(&r, Rgb565::from(RawU16::new(TORUS_PALETTE[i as usize])))
+                .unwrap();
+        }
+        let (mut hn, mut hr) = (Fnv::default(), Fnv::default());
+        for r in 0..rows as usize {
+            Nibbles::hash_row(&mut hn, &nib, r);
+            Rgb565::hash_row(&mut hr, &rgb, r);
+        }
+        assert_eq!(hn.0, hr.0);
+        assert_ne!(hr.0, Fnv::default().0);
+    }
+
+    /// A band of the wrong size is an error, not a panic.
+    #[test]
+    fn a_nibble_band_of_the_wrong_size_is_an_error() {
+        assert!(NibbleBand::band(&mut [0u8; 24], 10, 0, 5).is_err());
+        assert!(NibbleBand::band(&mut [0u8; 25], 9, 0, 5).is_err());
+        assert!(Nibbles::band(&mut [0u8; 10], 0, 1).is_err());
+    }
 }

@@ -3,10 +3,10 @@
 //! The frame does not fit in RAM: every standard scene is rendered in 30 bands of 8 rows (a 320x8 colour band and
 //! a 320x8 W16 band, 10 KiB), triangles binned by rows (see `wraster-board`), with this core's default (`Fast`), then
 //! the other strategies; one `bench` line per run over semihosting, exit 0; any error or panic exits non-zero.
-//! `--features torus` builds W4 instead (the rotating torus through the mesh path, 60 bands of 4 rows: its 512
-//! transformed vertices take 6 KiB of the 16, its row bins 1 KiB, its plane cache 1,088 bytes, and the deepest stack
-//! of the run, 2.6 KiB, leaves 300 bytes free: `boards/tools/stackdepth.c`, which CI runs on this build and fails
-//! under 256); `--features cull` adds the bounding-sphere cull's line and RV32's default strategy (`FastDivInt`).
+//! `--features torus` builds W4 instead (the rotating torus through the mesh path, 40 bands of 6 rows whose colour is
+//! a palette index a pixel, two to a byte: its 512 transformed vertices take 6 KiB of the 16, its row bins 1 KiB,
+//! its plane cache 1,424 bytes, and the deepest stack of the run, 2.6 KiB, leaves 284 bytes free: `boards/tools/stackdepth.c`, which
+//! CI runs on this build and fails under 256); `--features cull` adds the bounding-sphere cull's line and RV32's default strategy (`FastDivInt`).
 //! Run: `cd boards/qemu-m0 && cargo run --release` (the runner in `.cargo/config.toml` adds `-icount shift=0`).
 //!
 //! Instructions are counted with SysTick on the 16 MHz core clock: one tick is exactly 62.5 instructions under
@@ -39,9 +39,16 @@ use {
 /// Rows per band: the largest multiple of 8 whose two buffers leave room for the stack in 16 KiB.
 #[cfg(not(feature = "torus"))]
 const BAND_ROWS: usize = 8;
-/// With `--features torus` the 512 transformed vertices take 6 KiB, so the bands are 4 rows (60 bands, 5 KiB).
+/// With `--features torus` the 512 transformed vertices take 6 KiB, so the bands are 6 rows (40 bands, 4,800 bytes):
+/// W4's colours are eight palette entries, so its colour band holds a palette index a pixel, two to a byte
+/// (`wraster_board::NibbleBand`), not RGB565 (two bytes a pixel: 4 rows, 60 bands, 5,120 bytes). Taller bands set
+/// up fewer triangles again, and the plane cache took the bytes left (`wraster_board::TORUS_CACHE`): W4's frame
+/// (default `Fast`, commit 2124873's draw code, the same hash) 8,461,874 instructions with RGB565 in 4 rows and 38
+/// cached triangles; 7,839,211 with a byte a pixel in 5 rows and 50; 7,683,855 with half a byte in 6 rows and 50.
+/// The same firmware given more RAM (`memory.x` at 4M, run in QEMU's mps2-an386: the same instructions), 38 cached
+/// triangles, `Fast` alone: 4 rows 8,396,060 a frame, 5 rows 7,907,768, 6 rows 7,576,783, 8 rows 7,145,757.
 #[cfg(feature = "torus")]
-const BAND_ROWS: usize = 4;
+const BAND_ROWS: usize = 6;
 const PIXELS: usize = WIDTH as usize * BAND_ROWS;
 const _: () = assert!((HEIGHT as usize).is_multiple_of(BAND_ROWS));
 
@@ -136,17 +143,18 @@ type Cache = wraster::mesh::PlaneCache<{ wraster_board::TORUS_CACHE }>;
 #[cfg(all(feature = "torus", not(feature = "plan")))]
 #[entry]
 fn main() -> ! {
-    static mut COLOR: [u16; PIXELS] = [0; PIXELS];
+    // A palette index a pixel, two to a byte (`wraster_board::TORUS_PALETTE`): the band hashes as its RGB565 pixels.
+    static mut COLOR: [u8; PIXELS / 2] = [0; PIXELS / 2];
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
     static mut VERTS: [Projected; VERTICES] = [Projected {
         x: 0.0,
         y: 0.0,
         rhw: 0.0,
     }; VERTICES];
-    // The row bins (`Rasterizer::bin_mesh`, a byte per triangle): each of the 60 bands sets up only the triangles
+    // The row bins (`Rasterizer::bin_mesh`, a byte per triangle): each of the 40 bands sets up only the triangles
     // that can reach it.
     static mut BINS: [u8; TRIANGLES] = [0; TRIANGLES];
-    // The plane cache (`wraster::mesh::PlaneCache`, 38 triangles, 1,088 bytes): a triangle reaching several bands
+    // The plane cache (`wraster::mesh::PlaneCache`, 50 triangles, 1,424 bytes): a triangle reaching several bands
     // has its depth-grid values computed once a frame, not in each band. The same in the `cull` build: the stack
     // keeps 256 bytes free in both (`wraster_board::TORUS_CACHE`).
     static mut CACHE: Cache = Cache::new();
@@ -155,18 +163,19 @@ fn main() -> ! {
     // Out of line: one strategy's run at a time on the stack (measured by CI's `stack` line).
     #[inline(never)]
     fn torus<R: wraster::recip::SpanRecip>(
-        color: &mut [u16],
+        color: &mut [u8],
         depth: &mut [u16],
         verts: &mut [Projected],
         bins: &mut [u8],
         cache: &mut Cache,
         counter: &mut SysTick,
     ) -> bool {
-        wraster_board::run_torus_line::<R, _>(
+        wraster_board::run_torus_line_in::<R, wraster_board::Nibbles, _>(
             "qemu-m0",
             "m0",
             color,
             depth,
+            &mut [],
             verts,
             bins,
             cache,
