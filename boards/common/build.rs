@@ -12,6 +12,7 @@ fn main() {
     for scene in Scene::ALL {
         let name = scene.name().to_uppercase();
         let (near, far) = scene.depth_range();
+        let palette = nibble_palette(scene.tris().map(|t| t[0].color.into_storage()));
         writeln!(s, "static {name}: [Tri; {}] = [", scene.len()).unwrap();
         for t in scene.tris() {
             let (r0, r1) =
@@ -42,7 +43,7 @@ fn main() {
         writeln!(s, "];").unwrap();
         writeln!(
             list,
-            "    SceneData {{ name: {:?}, near: f32::from_bits({:#x}), far: f32::from_bits({:#x}), tris: &{name} }},",
+            "    SceneData {{ name: {:?}, near: f32::from_bits({:#x}), far: f32::from_bits({:#x}), tris: &{name}, palette: {palette} }},",
             scene.name(),
             near.to_bits(),
             far.to_bits()
@@ -88,11 +89,52 @@ fn main() {
         col.join(", ")
     )
     .unwrap();
+    writeln!(
+        s,
+        "/// W4's colours as a nibble palette ([`NibbleBand`]).\npub static TORUS_NIBBLES: NibblePalette = {};",
+        nibble_palette(torus::colors().iter().map(|c| c.into_storage()))
+    )
+    .unwrap();
     let out = std::path::PathBuf::from(std::env::var("OUT_DIR").unwrap()).join("scenes.rs");
     std::fs::write(out, s).unwrap();
     plans();
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=../../src");
+}
+
+/// A scene's colours (RGB565) as a `NibblePalette`: the background 0 and every colour, each at slot
+/// `(c * k) >> 28` for the first multiplier `k` (odd, from a fixed sequence) that puts no two in one slot (0 goes to
+/// slot 0 whatever `k`). Panics for a scene of more than 15 colours besides the background, or one that uses 0.
+fn nibble_palette(colors: impl Iterator<Item = u16>) -> String {
+    let mut distinct: Vec<u16> = colors.collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    assert!(!distinct.contains(&0), "a scene colour is the background's");
+    assert!(
+        distinct.len() <= 15,
+        "{} colours do not fit a nibble",
+        distinct.len()
+    );
+    let mut k = 0x9e37_79b9u32;
+    loop {
+        let mut slots = [None::<u16>; 16];
+        slots[0] = Some(0);
+        let fits = distinct.iter().all(|&c| {
+            let i = ((c as u32).wrapping_mul(k) >> 28) as usize;
+            slots[i].replace(c).is_none()
+        });
+        if fits {
+            let colors: Vec<String> = slots
+                .iter()
+                .map(|c| format!("{:#06x}", c.unwrap_or(0)))
+                .collect();
+            return format!(
+                "NibblePalette {{ colors: [{}], k: {k:#x} }}",
+                colors.join(", ")
+            );
+        }
+        k = k.wrapping_mul(0x2c1b_3c6d).wrapping_add(0x297a_2d39) | 1;
+    }
 }
 
 /// The plans named by `PLAN` (comma-separated files written by host-tests' `plan` binary), each in a module `pN`,

@@ -41,6 +41,8 @@ pub struct SceneData {
     pub far: f32,
     /// Triangles in drawing order.
     pub tris: &'static [Tri],
+    /// Its colours, for a band of half a byte a pixel ([`Nibbles`]).
+    pub palette: NibblePalette,
 }
 
 include!(concat!(env!("OUT_DIR"), "/scenes.rs"));
@@ -267,10 +269,10 @@ pub trait SceneFrames {
 /// One triangle of a [`SceneFrames::Frame`] drawn into a band.
 pub trait DrawTris {
     /// Triangle `k` (`t`) into the band.
-    fn draw<R: SpanRecip>(
+    fn draw<R: SpanRecip, D: embedded_graphics_core::draw_target::DrawTarget<Color = Rgb565>>(
         &self,
         r: &mut Rasterizer<R>,
-        band: &mut ColorBand<'_, Rgb565>,
+        band: &mut D,
         buf: &mut DepthBuffer<'_>,
         k: usize,
         t: &Tri,
@@ -284,10 +286,10 @@ impl SceneFrames for () {
 
 impl DrawTris for () {
     #[inline(always)]
-    fn draw<R: SpanRecip>(
+    fn draw<R: SpanRecip, D: embedded_graphics_core::draw_target::DrawTarget<Color = Rgb565>>(
         &self,
         r: &mut Rasterizer<R>,
-        band: &mut ColorBand<'_, Rgb565>,
+        band: &mut D,
         buf: &mut DepthBuffer<'_>,
         _: usize,
         t: &Tri,
@@ -305,10 +307,10 @@ impl<const N: usize> SceneFrames for wraster::mesh::PlaneCache<N> {
 
 impl DrawTris for wraster::mesh::ListFrame<'_, Tri> {
     #[inline(always)]
-    fn draw<R: SpanRecip>(
+    fn draw<R: SpanRecip, D: embedded_graphics_core::draw_target::DrawTarget<Color = Rgb565>>(
         &self,
         r: &mut Rasterizer<R>,
-        band: &mut ColorBand<'_, Rgb565>,
+        band: &mut D,
         buf: &mut DepthBuffer<'_>,
         k: usize,
         _: &Tri,
@@ -333,22 +335,36 @@ pub fn run_scene_cached<R: SpanRecip, C: Counter>(
     counter: &mut C,
     on_band: impl FnMut(u16, &[u16]),
 ) -> Result<Run, Error> {
+    run_scene_banded::<R, Rgb565, C>(scene, color, depth, bound, cache, counter, on_band)
+}
+
+/// [`run_scene_cached`] with any [`BandKind`]: `color` holds its band's storage (half a byte a pixel for
+/// [`Nibbles`]); the band's height is `depth`'s rows.
+pub fn run_scene_banded<R: SpanRecip, B: BandKind, C: Counter>(
+    scene: &SceneData,
+    color: &mut [B::Store],
+    depth: &mut [u16],
+    bound: &mut [u16],
+    cache: &mut impl SceneFrames,
+    counter: &mut C,
+    on_band: impl FnMut(u16, &[B::Store]),
+) -> Result<Run, Error> {
     let state = RenderState::new(scene.near, scene.far)?;
-    run_scene_in::<R, C>(scene, state, color, depth, bound, cache, counter, on_band)
+    run_scene_in::<R, B, C>(scene, state, color, depth, bound, cache, counter, on_band)
 }
 
 /// [`run_scene_cached`] with the render state `state` (a plan's depth range), in bands of `depth.len() / WIDTH`
 /// rows.
 #[allow(clippy::too_many_arguments)]
-fn run_scene_in<R: SpanRecip, C: Counter>(
+fn run_scene_in<R: SpanRecip, B: BandKind, C: Counter>(
     scene: &SceneData,
     state: RenderState,
-    color: &mut [u16],
+    color: &mut [B::Store],
     depth: &mut [u16],
     bound: &mut [u16],
     cache: &mut impl SceneFrames,
     counter: &mut C,
-    mut on_band: impl FnMut(u16, &[u16]),
+    mut on_band: impl FnMut(u16, &[B::Store]),
 ) -> Result<Run, Error> {
     let band_h = (depth.len() / WIDTH as usize) as u16;
     let mut r = Rasterizer::<R>::new(state);
@@ -359,12 +375,11 @@ fn run_scene_in<R: SpanRecip, C: Counter>(
     while y0 < HEIGHT {
         let h = band_h.min(HEIGHT - y0);
         let n = WIDTH as usize * h as usize;
-        let (color, depth) = (&mut color[..n], &mut depth[..n]);
-        color.fill(0);
+        let depth = &mut depth[..n];
         let buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
         let mut buf = with_bound(buf, &mut *bound, h)?;
         buf.clear();
-        let mut band = ColorBand::<Rgb565>::band(color, WIDTH, y0 as i32, h)?;
+        let mut band = B::band(color, y0 as i32, h, &scene.palette)?;
         let (b0, b1) = (y0 as i32, (y0 + h) as i32 - 1);
         counter.start();
         for (k, t) in scene.tris.iter().enumerate() {
@@ -373,12 +388,14 @@ fn run_scene_in<R: SpanRecip, C: Counter>(
             }
         }
         instructions += counter.stop();
+        drop(band);
         let w = WIDTH as usize;
+        let color = &color[..B::len(h)];
         for row in 0..h as usize {
-            hash.words(&band.pixels()[row * w..(row + 1) * w]);
+            B::hash_row(&mut hash, color, row, &scene.palette);
             hash.words(&buf.data()[row * w..(row + 1) * w]);
         }
-        on_band(y0, band.pixels());
+        on_band(y0, color);
         bands += 1;
         y0 += h;
     }
@@ -667,7 +684,16 @@ pub fn run_plan<
         // triangles drawn one by one below).
         let (depth, rest) = split_depth(depth, WIDTH as usize * plan.band_rows as usize)?;
         let bound = if plan.coarse { rest } else { &mut [] };
-        return run_scene_in::<R, C>(scene, state, color, depth, bound, cache, counter, |_, _| {});
+        return run_scene_in::<R, Rgb565, C>(
+            scene,
+            state,
+            color,
+            depth,
+            bound,
+            cache,
+            counter,
+            |_, _| {},
+        );
     }
     let (instructions, bands) = run_planned_tris::<F, R, C, KIND>(
         // Only the triangles whose rows meet the band's, checked before their vertices are made (as `run_scene`
@@ -786,6 +812,21 @@ pub fn run_all_cached<R: SpanRecip, C: Counter>(
     bound: &mut [u16],
     cache: &mut impl SceneFrames,
     counter: &mut C,
+    print: impl FnMut(core::fmt::Arguments<'_>),
+) -> bool {
+    run_all_banded::<R, Rgb565, C>(board, core, color, depth, bound, cache, counter, print)
+}
+
+/// [`run_all_cached`] with any [`BandKind`] ([`run_scene_banded`]).
+#[allow(clippy::too_many_arguments)]
+pub fn run_all_banded<R: SpanRecip, B: BandKind, C: Counter>(
+    board: &str,
+    core: &str,
+    color: &mut [B::Store],
+    depth: &mut [u16],
+    bound: &mut [u16],
+    cache: &mut impl SceneFrames,
+    counter: &mut C,
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
     let mut ok = true;
@@ -793,7 +834,7 @@ pub fn run_all_cached<R: SpanRecip, C: Counter>(
         .iter()
         .filter(|s| option_env!("ONLY").is_none_or(|o| o == s.name))
     {
-        match run_scene_cached::<R, C>(
+        match run_scene_banded::<R, B, C>(
             scene,
             color,
             depth,
@@ -827,8 +868,8 @@ fn scene_line(
 
 /// Triangles a board's W4 plane cache holds ([`wraster::mesh::PlaneCache`]): those that reach the next band, and the
 /// previous band's until the walk meets them; a full cache only computes values again. 50 is what the M0's 16 KiB
-/// leave beside its 6-row bands of palette indices (its deepest stack then keeps 284 bytes free in the torus build
-/// and 276 in the `cull` build, over CI's 256), since the frame loop keeps its transform, its camera and its lines out
+/// leave beside its 6-row bands of half a byte a pixel (its deepest stack then keeps 276 bytes free in the torus build
+/// and 260 in the `cull` build, over CI's 256), since the frame loop keeps its transform, its camera and its lines out
 /// of line (`torus_frame`, `torus_view`, `torus_line`). Measured on the M0's W4 (default `Fast` alone, commit
 /// 2124873's draw code, its firmware given more RAM: `memory.x` at 4M, run in QEMU's mps2-an386, the same
 /// instructions): 5-row bands, 7,907,768 instructions a frame with 38, 7,747,448 with 49, 7,678,228 with 64,
@@ -842,74 +883,71 @@ pub type TorusCache = wraster::mesh::PlaneCache<TORUS_CACHE>;
 
 /// How a board's W4 run keeps its frames: as they are (`()`, for a frame in one band: nothing to cache) or with a
 /// plane cache ([`TorusCache`]). A type, not a value: a board links only the draw it uses.
-pub trait TorusFrames<P: Copy = Rgb565> {
+pub trait TorusFrames {
     /// The frame drawn.
-    type Frame<'a>: wraster::mesh::DrawFrame<'a, P>
+    type Frame<'a>: wraster::mesh::DrawFrame<'a, Rgb565>
     where
-        Self: 'a,
-        P: 'a;
+        Self: 'a;
     /// Frame `f` as drawn.
-    fn attach<'a>(&'a mut self, f: MeshFrame<'a, P>) -> Self::Frame<'a>;
+    fn attach<'a>(&'a mut self, f: MeshFrame<'a, Rgb565>) -> Self::Frame<'a>;
 }
 
-impl<P: Copy> TorusFrames<P> for () {
-    type Frame<'a>
-        = MeshFrame<'a, P>
-    where
-        P: 'a;
-    fn attach<'a>(&'a mut self, f: MeshFrame<'a, P>) -> MeshFrame<'a, P> {
+impl TorusFrames for () {
+    type Frame<'a> = MeshFrame<'a, Rgb565>;
+    fn attach<'a>(&'a mut self, f: MeshFrame<'a, Rgb565>) -> MeshFrame<'a, Rgb565> {
         f
     }
 }
 
-impl<P: Copy, const N: usize> TorusFrames<P> for wraster::mesh::PlaneCache<N> {
-    type Frame<'a>
-        = wraster::mesh::CachedFrame<'a, P>
-    where
-        P: 'a;
-    fn attach<'a>(&'a mut self, f: MeshFrame<'a, P>) -> Self::Frame<'a> {
+impl<const N: usize> TorusFrames for wraster::mesh::PlaneCache<N> {
+    type Frame<'a> = wraster::mesh::CachedFrame<'a, Rgb565>;
+    fn attach<'a>(&'a mut self, f: MeshFrame<'a, Rgb565>) -> Self::Frame<'a> {
         f.with_plane_cache(self)
     }
 }
 
-/// A palette index as a colour, turned into RGB565 by a palette as it leaves the band (for the display; here, for
-/// the hash): a scene of few colours (W4's eight and the background) then keeps half a byte a pixel ([`NibbleBand`])
-/// rather than two, which on the Cortex-M0's 16 KiB buys taller bands (its W4 build: 6 rows rather than 4).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct PaletteIndex(pub u8);
-
-impl embedded_graphics_core::pixelcolor::PixelColor for PaletteIndex {
-    type Raw = embedded_graphics_core::pixelcolor::raw::RawU8;
+/// Up to 16 RGB565 colours (the background, 0, at slot 0) and the multiplier that puts colour `c` at slot
+/// `(c k) >> 28`, for a band of half a byte a pixel ([`NibbleBand`]): baked per scene by build.rs, which checks that
+/// no two of the scene's colours share a slot.
+#[derive(Clone, Copy, Debug)]
+pub struct NibblePalette {
+    /// Slot `i`'s colour.
+    pub colors: [u16; 16],
+    /// The multiplier.
+    pub k: u32,
 }
 
-impl From<embedded_graphics_core::pixelcolor::raw::RawU8> for PaletteIndex {
-    fn from(r: embedded_graphics_core::pixelcolor::raw::RawU8) -> Self {
-        use embedded_graphics_core::pixelcolor::raw::RawData;
-        PaletteIndex(r.into_inner())
+impl NibblePalette {
+    /// Colour `c`'s slot (a colour the palette does not hold lands on some other colour's slot).
+    #[inline(always)]
+    pub fn slot(&self, c: u16) -> u8 {
+        ((c as u32).wrapping_mul(self.k) >> 28) as u8
     }
 }
 
-impl From<PaletteIndex> for embedded_graphics_core::pixelcolor::raw::RawU8 {
-    fn from(p: PaletteIndex) -> Self {
-        Self::new(p.0)
-    }
-}
-
-/// A band of palette indices packed two to a byte (pixel `x` of a row in byte `x / 2`, the low nibble for even `x`),
-/// a `DrawTarget` of [`PaletteIndex`] (indices below 16): W4's nine colours in half the bytes of [`PaletteIndex`]'s
-/// band, so that the Cortex-M0's W4 has 6-row bands in the RAM 5-row bands of whole bytes took. Rows `y0..y0 +
+/// An RGB565 colour band of half a byte a pixel: each pixel the slot of its colour in a [`NibblePalette`] (pixel `x`
+/// of a row in byte `x / 2`, the low nibble for even `x`), turned back into RGB565 as the band leaves (for the
+/// display; here, for the hash). A scene of at most 15 colours (every standard scene, W4's eight) then keeps 2.5
+/// bytes a pixel with W16 depth rather than 4, which on the Cortex-M0's 16 KiB buys taller bands. Rows `y0..y0 +
 /// height` of the frame; writes outside them, or outside the columns, are dropped.
 pub struct NibbleBand<'a> {
     px: &'a mut [u8],
     width: usize,
     height: usize,
     y0: i32,
+    palette: &'a NibblePalette,
 }
 
 impl<'a> NibbleBand<'a> {
-    /// A band of `height` rows of `width` (even) pixels from frame row `y0`: `px.len()` must be `width * height / 2`
-    /// (else [`Error::BufferSize`], as for an odd or zero size).
-    pub fn band(px: &'a mut [u8], width: u16, y0: i32, height: u16) -> Result<Self, Error> {
+    /// A band of `height` rows of `width` (even) pixels from frame row `y0` in `palette`: `px.len()` must be
+    /// `width * height / 2` (else [`Error::BufferSize`], as for an odd or zero size).
+    pub fn band(
+        px: &'a mut [u8],
+        width: u16,
+        y0: i32,
+        height: u16,
+        palette: &'a NibblePalette,
+    ) -> Result<Self, Error> {
         let expected = width as usize * height as usize / 2;
         if px.len() != expected || width == 0 || height == 0 || !width.is_multiple_of(2) {
             return Err(Error::BufferSize {
@@ -922,6 +960,7 @@ impl<'a> NibbleBand<'a> {
             width: width as usize,
             height: height as usize,
             y0,
+            palette,
         })
     }
 
@@ -942,7 +981,7 @@ impl<'a> NibbleBand<'a> {
         }
     }
 
-    /// Columns `x0..x1` (inside the row) of `row` set to the index `v` (below 16).
+    /// Columns `x0..x1` (inside the row) of `row` set to the slot `v` (below 16).
     #[inline(always)]
     fn fill_row(row: &mut [u8], x0: usize, x1: usize, v: u8) {
         let mut x = x0;
@@ -978,18 +1017,19 @@ impl embedded_graphics_core::geometry::Dimensions for NibbleBand<'_> {
 }
 
 impl embedded_graphics_core::draw_target::DrawTarget for NibbleBand<'_> {
-    type Color = PaletteIndex;
+    type Color = Rgb565;
     type Error = core::convert::Infallible;
 
-    fn draw_iter<I: IntoIterator<Item = embedded_graphics_core::Pixel<PaletteIndex>>>(
+    fn draw_iter<I: IntoIterator<Item = embedded_graphics_core::Pixel<Rgb565>>>(
         &mut self,
         pixels: I,
     ) -> Result<(), Self::Error> {
-        let width = self.width;
+        use embedded_graphics_core::pixelcolor::IntoStorage;
+        let (width, palette) = (self.width, self.palette);
         for embedded_graphics_core::Pixel(p, c) in pixels {
             if let (Some(row), Ok(x)) = (self.row_mut(p.y), usize::try_from(p.x)) {
                 if x < width {
-                    Self::fill_row(row, x, x + 1, c.0 & 15);
+                    Self::fill_row(row, x, x + 1, palette.slot(c.into_storage()));
                 }
             }
         }
@@ -1001,85 +1041,79 @@ impl embedded_graphics_core::draw_target::DrawTarget for NibbleBand<'_> {
     fn fill_solid(
         &mut self,
         area: &embedded_graphics_core::primitives::Rectangle,
-        color: PaletteIndex,
+        color: Rgb565,
     ) -> Result<(), Self::Error> {
+        use embedded_graphics_core::pixelcolor::IntoStorage;
+        let v = self.palette.slot(color.into_storage());
         let (p, size) = (area.top_left, area.size);
+        // A rasterizer's run (one row, inside the columns): no clipping, the row found once.
+        let (x, w, r) = (
+            p.x as u32 as usize,
+            size.width as usize,
+            p.y.wrapping_sub(self.y0) as u32 as usize,
+        );
+        if size.height == 1 && r < self.height && x <= self.width && w <= self.width - x {
+            let at = r * self.width + x; // in nibbles
+            Self::fill_row(self.px, at, at + w, v);
+            return Ok(());
+        }
         let x0 = p.x.max(0) as usize;
         let x1 = (p.x.saturating_add_unsigned(size.width).max(0) as usize).min(self.width);
         if x0 < x1 {
             for y in p.y..p.y.saturating_add_unsigned(size.height) {
                 if let Some(row) = self.row_mut(y) {
-                    Self::fill_row(row, x0, x1, color.0 & 15);
+                    Self::fill_row(row, x0, x1, v);
                 }
             }
         }
         Ok(())
     }
 
-    fn clear(&mut self, color: PaletteIndex) -> Result<(), Self::Error> {
-        let v = color.0 & 15;
+    fn clear(&mut self, color: Rgb565) -> Result<(), Self::Error> {
+        use embedded_graphics_core::pixelcolor::IntoStorage;
+        let v = self.palette.slot(color.into_storage());
         self.px.fill(v | v << 4);
         Ok(())
     }
 }
 
-/// W4's palette by index: 0 the background (the cleared band), `1 + k mod 8` triangle `k`'s
-/// (`wraster::scenes::torus::PALETTE`).
-pub const TORUS_PALETTE: [u16; 9] = {
-    let (mut p, mut k) = ([0u16; 9], 0);
-    while k < 8 {
-        p[k + 1] = wraster::scenes::torus::PALETTE[k];
-        k += 1;
-    }
-    p
-};
-
-/// W4's face colours as indices into [`TORUS_PALETTE`] (flash).
-pub static TORUS_FACE_INDICES: [PaletteIndex; wraster::scenes::torus::TRIANGLES] = {
-    let (mut f, mut k) = ([PaletteIndex(0); wraster::scenes::torus::TRIANGLES], 0);
-    while k < f.len() {
-        f[k] = PaletteIndex(1 + (k % 8) as u8);
-        k += 1;
-    }
-    f
-};
-
-/// How W4's frames keep their colour band: RGB565 in a [`ColorBand`] (`Rgb565`), or palette indices packed two to a
-/// byte in a [`NibbleBand`] ([`Nibbles`]). Either way a band hashes as its RGB565 pixels, so the frames' hashes are
-/// the same. A type, not a value: a board links only the band it uses.
-pub trait TorusTarget {
-    /// The colour drawn.
-    type Color: embedded_graphics_core::pixelcolor::PixelColor + 'static;
+/// How a board keeps its colour band: RGB565 in a [`ColorBand`] (`Rgb565`, two bytes a pixel), or half a byte a
+/// pixel in a [`NibbleBand`] ([`Nibbles`], with the scene's [`NibblePalette`]). Either way a band hashes as its
+/// RGB565 pixels, so the frames' hashes are the same. A type, not a value: a board links only the band it uses.
+pub trait BandKind {
     /// The band's storage element.
     type Store: bytemuck::Pod;
     /// The band as a draw target.
-    type Band<'a>: embedded_graphics_core::draw_target::DrawTarget<Color = Self::Color>;
+    type Band<'a>: embedded_graphics_core::draw_target::DrawTarget<Color = Rgb565>;
     /// Storage elements of a band of `rows` rows.
     fn len(rows: u16) -> usize;
-    /// The band of frame rows `y0..y0 + rows` in `px` (at least [`TorusTarget::len`] long), cleared to the
-    /// background.
-    fn band(px: &mut [Self::Store], y0: i32, rows: u16) -> Result<Self::Band<'_>, Error>;
-    /// Triangle `k`'s colour, element `k`.
-    fn faces() -> &'static [Self::Color];
+    /// The band of frame rows `y0..y0 + rows` at the front of `px`, cleared to the background (`palette`: the
+    /// scene's colours, for a band that needs them).
+    fn band<'a>(
+        px: &'a mut [Self::Store],
+        y0: i32,
+        rows: u16,
+        palette: &'a NibblePalette,
+    ) -> Result<Self::Band<'a>, Error>;
     /// Hashes the band's row `r` (`WIDTH` pixels) as its RGB565 words.
-    fn hash_row(hash: &mut Fnv, px: &[Self::Store], r: usize);
+    fn hash_row(hash: &mut Fnv, px: &[Self::Store], r: usize, palette: &NibblePalette);
 }
 
-impl TorusTarget for Rgb565 {
-    type Color = Rgb565;
+impl BandKind for Rgb565 {
     type Store = u16;
     type Band<'a> = ColorBand<'a, Rgb565>;
     fn len(rows: u16) -> usize {
         WIDTH as usize * rows as usize
     }
-    fn band(px: &mut [u16], y0: i32, rows: u16) -> Result<ColorBand<'_, Rgb565>, Error> {
-        let px = cleared_front(px, Self::len(rows))?;
-        ColorBand::band(px, WIDTH, y0, rows)
+    fn band<'a>(
+        px: &'a mut [u16],
+        y0: i32,
+        rows: u16,
+        _: &'a NibblePalette,
+    ) -> Result<ColorBand<'a, Rgb565>, Error> {
+        ColorBand::band(cleared_front(px, Self::len(rows))?, WIDTH, y0, rows)
     }
-    fn faces() -> &'static [Rgb565] {
-        &TORUS_COLORS
-    }
-    fn hash_row(hash: &mut Fnv, px: &[u16], r: usize) {
+    fn hash_row(hash: &mut Fnv, px: &[u16], r: usize, _: &NibblePalette) {
         let w = WIDTH as usize;
         hash.words(px.get(r * w..(r + 1) * w).unwrap_or(&[]));
     }
@@ -1096,28 +1130,34 @@ fn cleared_front<T: bytemuck::Pod>(px: &mut [T], n: usize) -> Result<&mut [T], E
     Ok(px)
 }
 
-/// [`TorusTarget`]'s band of palette indices, two to a byte ([`NibbleBand`], [`TORUS_PALETTE`]).
+/// [`BandKind`]'s band of half a byte a pixel ([`NibbleBand`]).
 pub struct Nibbles;
 
-impl TorusTarget for Nibbles {
-    type Color = PaletteIndex;
+impl BandKind for Nibbles {
     type Store = u8;
     type Band<'a> = NibbleBand<'a>;
     fn len(rows: u16) -> usize {
         WIDTH as usize * rows as usize / 2
     }
-    fn band(px: &mut [u8], y0: i32, rows: u16) -> Result<NibbleBand<'_>, Error> {
-        let px = cleared_front(px, Self::len(rows))?;
-        NibbleBand::band(px, WIDTH, y0, rows)
+    fn band<'a>(
+        px: &'a mut [u8],
+        y0: i32,
+        rows: u16,
+        palette: &'a NibblePalette,
+    ) -> Result<NibbleBand<'a>, Error> {
+        NibbleBand::band(
+            cleared_front(px, Self::len(rows))?,
+            WIDTH,
+            y0,
+            rows,
+            palette,
+        )
     }
-    fn faces() -> &'static [PaletteIndex] {
-        &TORUS_FACE_INDICES
-    }
-    fn hash_row(hash: &mut Fnv, px: &[u8], r: usize) {
+    fn hash_row(hash: &mut Fnv, px: &[u8], r: usize, palette: &NibblePalette) {
         let stride = WIDTH as usize / 2;
         for &b in px.get(r * stride..(r + 1) * stride).unwrap_or(&[]) {
             for i in [b & 15, b >> 4] {
-                hash.words(&[TORUS_PALETTE.get(i as usize).copied().unwrap_or(0)]);
+                hash.words(&[palette.colors[i as usize]]);
             }
         }
     }
@@ -1155,9 +1195,9 @@ pub fn run_torus<R: SpanRecip, C: Counter>(
 /// `on_band` (first row, pixels). Returns the draws' instructions (not the clears or the hash) and the bands.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn mesh_frame_in_bands<'a, R: SpanRecip, T: TorusTarget, C: Counter>(
+fn mesh_frame_in_bands<'a, R: SpanRecip, T: BandKind, C: Counter>(
     r: &mut Rasterizer<R>,
-    frame: &impl wraster::mesh::DrawFrame<'a, T::Color>,
+    frame: &impl wraster::mesh::DrawFrame<'a, Rgb565>,
     band_h: u16,
     color: &mut [T::Store],
     depth: &mut [u16],
@@ -1176,7 +1216,7 @@ fn mesh_frame_in_bands<'a, R: SpanRecip, T: TorusTarget, C: Counter>(
         let buf = DepthBuffer::band(depth, WIDTH, y0 as i32, h)?;
         let mut buf = with_bound(buf, &mut *bound, h)?;
         buf.clear();
-        let mut band = T::band(color, y0 as i32, h)?;
+        let mut band = T::band(color, y0 as i32, h, &TORUS_NIBBLES)?;
         counter.start();
         let s = r.draw_mesh_frame(&mut band, &mut buf, frame);
         instructions += counter.stop();
@@ -1194,13 +1234,13 @@ fn mesh_frame_in_bands<'a, R: SpanRecip, T: TorusTarget, C: Counter>(
 /// Hashes a band's rows (`w` pixels each): each row's colours, then its depths. Out of line: its loop's registers
 /// are then not spilled to the stack under the frame's draws (the Cortex-M0's plane cache is sized by that stack).
 #[inline(never)]
-fn hash_band<T: TorusTarget>(hash: &mut Fnv, colors: &[T::Store], depths: &[u16], rows: u16) {
+fn hash_band<T: BandKind>(hash: &mut Fnv, colors: &[T::Store], depths: &[u16], rows: u16) {
     for (r, d) in depths
         .chunks_exact(WIDTH as usize)
         .take(rows as usize)
         .enumerate()
     {
-        T::hash_row(hash, colors, r);
+        T::hash_row(hash, colors, r, &TORUS_NIBBLES);
         hash.words(d);
     }
 }
@@ -1233,13 +1273,13 @@ pub fn run_torus_with<R: SpanRecip, C: Counter>(
 
 /// [`run_torus_with`], each band's depth buffer keeping a coarse bound in `bound` (feature `coarse`; empty: none).
 #[allow(clippy::too_many_arguments)]
-pub fn run_torus_bounded<R: SpanRecip, T: TorusTarget, C: Counter>(
+pub fn run_torus_bounded<R: SpanRecip, T: BandKind, C: Counter>(
     color: &mut [T::Store],
     depth: &mut [u16],
     bound: &mut [u16],
     verts: &mut [Projected],
     bins: &mut [u8],
-    cache: &mut impl TorusFrames<T::Color>,
+    cache: &mut impl TorusFrames,
     counter: &mut C,
     frames: core::ops::Range<usize>,
     mut on_band: impl FnMut(u16, &[T::Store]),
@@ -1251,7 +1291,7 @@ pub fn run_torus_bounded<R: SpanRecip, T: TorusTarget, C: Counter>(
     let mesh = Mesh {
         positions: &TORUS_POSITIONS,
         indices: &TORUS_INDICES,
-        colors: Colors::PerFace(T::faces()),
+        colors: Colors::PerFace(&TORUS_COLORS),
     };
     let vp = Viewport::new(0.0, 0.0, WIDTH as f32, HEIGHT as f32);
     let mut stats = Stats::default();
@@ -1308,11 +1348,11 @@ fn torus_view() -> Result<(wraster::RenderState, wraster::projection::Mat4), Err
 /// under its draws, which on the Cortex-M0 set how many triangles its plane cache can hold.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn torus_frame<'a, R: SpanRecip, P: Copy, C: Counter, T: TorusFrames<P>>(
+fn torus_frame<'a, R: SpanRecip, C: Counter, T: TorusFrames>(
     r: &Rasterizer<R>,
     to_clip: &wraster::projection::Mat4,
     k: usize,
-    mesh: &Mesh<'a, P>,
+    mesh: &Mesh<'a, Rgb565>,
     vp: &Viewport,
     verts: &'a mut [Projected],
     bins: &'a mut [u8],
@@ -1383,10 +1423,10 @@ pub fn run_torus_line_bounded<R: SpanRecip, C: Counter>(
     )
 }
 
-/// [`run_torus_line_bounded`] with any [`TorusTarget`]: `color` holds its band's storage (half a byte a pixel for
+/// [`run_torus_line_bounded`] with any [`BandKind`]: `color` holds its band's storage (half a byte a pixel for
 /// [`Nibbles`]); the band's height is `depth`'s rows.
 #[allow(clippy::too_many_arguments)]
-pub fn run_torus_line_in<R: SpanRecip, T: TorusTarget, C: Counter>(
+pub fn run_torus_line_in<R: SpanRecip, T: BandKind, C: Counter>(
     board: &str,
     core: &str,
     color: &mut [T::Store],
@@ -1394,7 +1434,7 @@ pub fn run_torus_line_in<R: SpanRecip, T: TorusTarget, C: Counter>(
     bound: &mut [u16],
     verts: &mut [Projected],
     bins: &mut [u8],
-    cache: &mut impl TorusFrames<T::Color>,
+    cache: &mut impl TorusFrames,
     counter: &mut C,
     mut print: impl FnMut(core::fmt::Arguments<'_>),
 ) -> bool {
@@ -1558,12 +1598,19 @@ mod tests {
     use embedded_graphics_core::geometry::{Point, Size};
     use embedded_graphics_core::primitives::Rectangle;
 
+    fn rgb(c: u16) -> Rgb565 {
+        Rgb565::from(RawU16::new(c))
+    }
+
     /// Every rectangle (inside, across every side, empty, far outside, from every column's parity) fills exactly its
     /// pixels inside the band and keeps the rest, and `draw_iter` writes exactly the pixels inside: checked against a
-    /// model of one index a pixel, on a band 10 pixels wide and 5 rows high at frame row 7.
+    /// model of one colour a pixel, on a band 10 pixels wide and 5 rows high at frame row 7, in W4's palette.
     #[test]
     fn a_nibble_band_fills_exactly_the_pixels_inside() {
         let (w, h, y0) = (10usize, 5usize, 7i32);
+        let pal = &TORUS_NIBBLES;
+        let colors: Vec<u16> = pal.colors.iter().copied().filter(|&c| c != 0).collect();
+        assert_eq!(colors.len(), 8);
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
         let mut rnd = move |n: i32| {
             state ^= state << 13;
@@ -1571,59 +1618,80 @@ mod tests {
             state ^= state << 17;
             (state % n as u64) as i32
         };
-        let (mut px, mut model) = ([0u8; 25], [0u8; 50]);
+        let (mut px, mut model) = ([0u8; 25], [0u16; 50]);
         for k in 0..5000 {
-            let v = rnd(16) as u8;
-            let mut band = NibbleBand::band(&mut px, w as u16, y0, h as u16).unwrap();
+            let c = colors[rnd(8) as usize];
+            let mut band = NibbleBand::band(&mut px, w as u16, y0, h as u16, pal).unwrap();
             let (x, y) = (rnd(16) - 3, rnd(11) + y0 - 3);
             if k % 2 == 0 {
                 let (rw, rh) = (rnd(14) as u32, rnd(4) as u32);
-                band.fill_solid(
-                    &Rectangle::new(Point::new(x, y), Size::new(rw, rh)),
-                    PaletteIndex(v),
-                )
-                .unwrap();
+                band.fill_solid(&Rectangle::new(Point::new(x, y), Size::new(rw, rh)), rgb(c))
+                    .unwrap();
                 for j in y..y + rh as i32 {
                     for i in x..x + rw as i32 {
                         if (0..w as i32).contains(&i) && (y0..y0 + h as i32).contains(&j) {
-                            model[(j - y0) as usize * w + i as usize] = v;
+                            model[(j - y0) as usize * w + i as usize] = c;
                         }
                     }
                 }
             } else {
-                band.draw_iter([embedded_graphics_core::Pixel(
-                    Point::new(x, y),
-                    PaletteIndex(v),
-                )])
-                .unwrap();
+                band.draw_iter([embedded_graphics_core::Pixel(Point::new(x, y), rgb(c))])
+                    .unwrap();
                 if (0..w as i32).contains(&x) && (y0..y0 + h as i32).contains(&y) {
-                    model[(y - y0) as usize * w + x as usize] = v;
+                    model[(y - y0) as usize * w + x as usize] = c;
                 }
             }
-            let unpacked: Vec<u8> = px.iter().flat_map(|b| [b & 15, b >> 4]).collect();
+            let unpacked: Vec<u16> = px
+                .iter()
+                .flat_map(|b| [b & 15, b >> 4])
+                .map(|i| pal.colors[i as usize])
+                .collect();
             assert_eq!(unpacked, model, "after step {k}");
         }
     }
 
-    /// A band of palette indices hashes as the RGB565 band of their palette colours (`Nibbles` against `Rgb565`):
-    /// so W4's hash is the same whichever band a board keeps.
+    /// Every scene's palette (baked by build.rs) holds each of its triangles' colours in a slot of its own, and the
+    /// background 0 in slot 0: so a band of half a byte a pixel keeps every colour it is given.
+    #[test]
+    fn every_scene_palette_holds_its_colours() {
+        for scene in &SCENES {
+            let pal = &scene.palette;
+            assert_eq!((pal.slot(0), pal.colors[0]), (0, 0));
+            for t in scene.tris {
+                assert_eq!(
+                    pal.colors[pal.slot(t.color) as usize],
+                    t.color,
+                    "{}",
+                    scene.name
+                );
+            }
+        }
+        for &c in TORUS_COLORS.iter() {
+            use embedded_graphics_core::pixelcolor::IntoStorage;
+            let c = c.into_storage();
+            assert_eq!(TORUS_NIBBLES.colors[TORUS_NIBBLES.slot(c) as usize], c);
+        }
+    }
+
+    /// A band of half a byte a pixel hashes as the RGB565 band of the same draws (`Nibbles` against `Rgb565`): so a
+    /// frame's hash is the same whichever band a board keeps.
     #[test]
     fn a_nibble_band_hashes_as_its_rgb565_colours() {
         let rows = 3u16;
-        let (mut nib, mut rgb) = (vec![0u8; Nibbles::len(rows)], vec![0u16; Rgb565::len(rows)]);
-        let mut b = Nibbles::band(&mut nib, 20, rows).unwrap();
-        let mut c = Rgb565::band(&mut rgb, 20, rows).unwrap();
+        let pal = &SCENES[3].palette;
+        let (mut nib, mut rgb565) = (vec![0u8; Nibbles::len(rows)], vec![0u16; Rgb565::len(rows)]);
+        let mut b = Nibbles::band(&mut nib, 20, rows, pal).unwrap();
+        let mut c = Rgb565::band(&mut rgb565, 20, rows, pal).unwrap();
         for (k, x) in (0..WIDTH as i32).step_by(7).enumerate() {
-            let i = (k % 9) as u8;
+            let t = &SCENES[3].tris[k * 13 % SCENES[3].tris.len()];
             let r = Rectangle::new(Point::new(x, 20 + (k % 3) as i32), Size::new(5, 1));
-            b.fill_solid(&r, PaletteIndex(i)).unwrap();
-            c.fill_solid(&r, Rgb565::from(RawU16::new(TORUS_PALETTE[i as usize])))
-                .unwrap();
+            b.fill_solid(&r, rgb(t.color)).unwrap();
+            c.fill_solid(&r, rgb(t.color)).unwrap();
         }
         let (mut hn, mut hr) = (Fnv::default(), Fnv::default());
         for r in 0..rows as usize {
-            Nibbles::hash_row(&mut hn, &nib, r);
-            Rgb565::hash_row(&mut hr, &rgb, r);
+            Nibbles::hash_row(&mut hn, &nib, r, pal);
+            Rgb565::hash_row(&mut hr, &rgb565, r, pal);
         }
         assert_eq!(hn.0, hr.0);
         assert_ne!(hr.0, Fnv::default().0);
@@ -1632,8 +1700,9 @@ mod tests {
     /// A band of the wrong size is an error, not a panic.
     #[test]
     fn a_nibble_band_of_the_wrong_size_is_an_error() {
-        assert!(NibbleBand::band(&mut [0u8; 24], 10, 0, 5).is_err());
-        assert!(NibbleBand::band(&mut [0u8; 25], 9, 0, 5).is_err());
-        assert!(Nibbles::band(&mut [0u8; 10], 0, 1).is_err());
+        let pal = &TORUS_NIBBLES;
+        assert!(NibbleBand::band(&mut [0u8; 24], 10, 0, 5, pal).is_err());
+        assert!(NibbleBand::band(&mut [0u8; 25], 9, 0, 5, pal).is_err());
+        assert!(Nibbles::band(&mut [0u8; 10], 0, 1, pal).is_err());
     }
 }

@@ -1,11 +1,11 @@
 //! wraster on QEMU `microbit` (nRF51, Cortex-M0, 16 KiB RAM, thumbv6m-none-eabi), memory map in `memory.x`.
 //!
-//! The frame does not fit in RAM: every standard scene is rendered in 30 bands of 8 rows (a 320x8 colour band and
-//! a 320x8 W16 band, 10 KiB), triangles binned by rows (see `wraster-board`), with this core's default (`Fast`), then
+//! The frame does not fit in RAM: every standard scene is rendered in 20 bands of 12 rows (a 320x12 colour band of
+//! half a byte a pixel, `wraster_board::NibbleBand`, and a 320x12 W16 band: 9,600 bytes), triangles binned by rows (see `wraster-board`), with this core's default (`Fast`), then
 //! the other strategies; one `bench` line per run over semihosting, exit 0; any error or panic exits non-zero.
 //! `--features torus` builds W4 instead (the rotating torus through the mesh path, 40 bands of 6 rows whose colour is
 //! a palette index a pixel, two to a byte: its 512 transformed vertices take 6 KiB of the 16, its row bins 1 KiB,
-//! its plane cache 1,424 bytes, and the deepest stack of the run, 2.6 KiB, leaves 284 bytes free: `boards/tools/stackdepth.c`, which
+//! its plane cache 1,424 bytes, and the deepest stack of the run, 2.6 KiB, leaves 276 bytes free: `boards/tools/stackdepth.c`, which
 //! CI runs on this build and fails under 256); `--features cull` adds the bounding-sphere cull's line and RV32's default strategy (`FastDivInt`).
 //! Run: `cd boards/qemu-m0 && cargo run --release` (the runner in `.cargo/config.toml` adds `-icount shift=0`).
 //!
@@ -26,9 +26,11 @@ use wraster::recip::SpanRecip;
 #[cfg(not(any(feature = "size-probe", feature = "plan")))]
 use wraster::recip::{Exact, FastDiv, PrevPixel};
 #[cfg(not(feature = "torus"))]
-use wraster_board::run_all_cached;
+use wraster_board::run_all_banded;
+#[cfg(not(feature = "torus"))]
+use wraster_board::Nibbles;
 #[cfg(not(any(feature = "size-probe", feature = "torus")))]
-use wraster_board::{run_scene_cached, SCENES};
+use wraster_board::{run_scene_banded, SCENES};
 use wraster_board::{SysTick, HEIGHT, WIDTH};
 #[cfg(feature = "torus")]
 use {
@@ -36,15 +38,17 @@ use {
     wraster::scenes::torus::{TRIANGLES, VERTICES},
 };
 
-/// Rows per band: the largest multiple of 8 whose two buffers leave room for the stack in 16 KiB.
+/// Rows per band of the standard scenes: 12 (20 bands; 30 of 8 rows before), their colour band holding each pixel's
+/// slot in the scene's palette, two to a byte (`wraster_board::NibbleBand`; every standard scene has at most 13
+/// colours): 9,600 bytes with the W16 band, where 8 rows of RGB565 took 10,240.
 #[cfg(not(feature = "torus"))]
-const BAND_ROWS: usize = 8;
+const BAND_ROWS: usize = 12;
 /// With `--features torus` the 512 transformed vertices take 6 KiB, so the bands are 6 rows (40 bands, 4,800 bytes):
 /// W4's colours are eight palette entries, so its colour band holds a palette index a pixel, two to a byte
 /// (`wraster_board::NibbleBand`), not RGB565 (two bytes a pixel: 4 rows, 60 bands, 5,120 bytes). Taller bands set
 /// up fewer triangles again, and the plane cache took the bytes left (`wraster_board::TORUS_CACHE`): W4's frame
 /// (default `Fast`, commit 2124873's draw code, the same hash) 8,461,874 instructions with RGB565 in 4 rows and 38
-/// cached triangles; 7,839,211 with a byte a pixel in 5 rows and 50; 7,683,855 with half a byte in 6 rows and 50.
+/// cached triangles; 7,839,211 with a byte a pixel in 5 rows and 50; 7,597,535 with half a byte in 6 rows and 50.
 /// The same firmware given more RAM (`memory.x` at 4M, run in QEMU's mps2-an386: the same instructions), 38 cached
 /// triangles, `Fast` alone: 4 rows 8,396,060 a frame, 5 rows 7,907,768, 6 rows 7,576,783, 8 rows 7,145,757.
 #[cfg(feature = "torus")]
@@ -52,11 +56,13 @@ const BAND_ROWS: usize = 6;
 const PIXELS: usize = WIDTH as usize * BAND_ROWS;
 const _: () = assert!((HEIGHT as usize).is_multiple_of(BAND_ROWS));
 
-/// The standard scenes' plane cache on this board: 86 triangles (2,432 bytes), which hold W3's triangles across a
-/// band's edge (64, the other boards' `SCENE_CACHE`, did not: W3 0.9% and the terrain 1.9% more instructions; 84 cost
-/// W3 0.25% more than 86; 112 saved nothing more: the terrain 0.06%). The deepest stack keeps 996 bytes free since
-/// the bench lines are written out of line (292 before; CI fails under 256). 64 with `--features coarse`, whose bound
-/// takes 640 bytes: 1,332 bytes free with `size-probe` (CI checks that build too).
+/// The standard scenes' plane cache on this board: 86 triangles (2,432 bytes), which held W3's triangles across the
+/// edges of 8-row bands (64, the other boards' `SCENE_CACHE`, did not: W3 0.9% and the terrain 1.9% more
+/// instructions; 84 cost W3 0.25% more than 86; 112 saved nothing more: the terrain 0.06%). With 12-row bands the
+/// deepest stack keeps 1,620 bytes free (CI fails under 256); more slots measured 0.9% fewer instructions on W3 with
+/// 92, 104, 112 or 120 and none with 98, 126 or 134, which is the code's layout, not the cache's room: kept at 86.
+/// 64 with `--features coarse`, whose bound takes 960 bytes: 1,676 bytes free with `size-probe` (CI checks that build
+/// too).
 #[cfg(not(feature = "torus"))]
 type SceneCache = wraster::mesh::PlaneCache<
     {
@@ -70,12 +76,12 @@ type SceneCache = wraster::mesh::PlaneCache<
 
 #[cfg(not(feature = "torus"))]
 fn all<R: SpanRecip>(
-    color: &mut [u16],
+    color: &mut [u8],
     depth: &mut [u16],
     cache: &mut SceneCache,
     counter: &mut SysTick,
 ) -> bool {
-    run_all_cached::<R, _>(
+    run_all_banded::<R, Nibbles, _>(
         "qemu-m0",
         "m0",
         color,
@@ -87,12 +93,12 @@ fn all<R: SpanRecip>(
     )
 }
 
-/// The cost of banding, measured on this core: every scene drawn again in 60 bands of 4 rows; the extra
-/// instructions over the 30-band run, divided by the 30 extra bands, are what one band costs (triangle setup
-/// repeated for triangles spanning both halves, the span walk restarted, the binning test).
+/// The cost of banding, measured on this core: every scene drawn again in bands of half the height (40 of 6 rows);
+/// the extra instructions over the run in 20 bands, divided by the 20 extra bands, are what one band costs (triangle
+/// setup repeated for triangles spanning both halves, the span walk restarted, the binning test).
 #[cfg(not(any(feature = "size-probe", feature = "torus")))]
 fn band_overhead(
-    color: &mut [u16],
+    color: &mut [u8],
     depth: &mut [u16],
     cache: &mut SceneCache,
     counter: &mut SysTick,
@@ -100,18 +106,26 @@ fn band_overhead(
     let half = WIDTH as usize * BAND_ROWS / 2;
     fn run(
         scene: &wraster_board::SceneData,
-        color: &mut [u16],
+        color: &mut [u8],
         depth: &mut [u16],
         cache: &mut SceneCache,
         counter: &mut SysTick,
     ) -> Result<wraster_board::Run, wraster::Error> {
-        run_scene_cached::<Fast, _>(scene, color, depth, &mut [], cache, counter, |_, _| {})
+        run_scene_banded::<Fast, Nibbles, _>(
+            scene,
+            color,
+            depth,
+            &mut [],
+            cache,
+            counter,
+            |_, _| {},
+        )
     }
     for scene in &SCENES {
         let r30 = run(scene, color, depth, cache, counter);
         let r60 = run(
             scene,
-            &mut color[..half],
+            &mut color[..half / 2],
             &mut depth[..half],
             cache,
             counter,
@@ -143,7 +157,7 @@ type Cache = wraster::mesh::PlaneCache<{ wraster_board::TORUS_CACHE }>;
 #[cfg(all(feature = "torus", not(feature = "plan")))]
 #[entry]
 fn main() -> ! {
-    // A palette index a pixel, two to a byte (`wraster_board::TORUS_PALETTE`): the band hashes as its RGB565 pixels.
+    // Each pixel's slot in W4's palette, two to a byte (`wraster_board::TORUS_NIBBLES`): it hashes as its RGB565 colour.
     static mut COLOR: [u8; PIXELS / 2] = [0; PIXELS / 2];
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
     static mut VERTS: [Projected; VERTICES] = [Projected {
@@ -219,7 +233,8 @@ fn main() -> ! {
 #[cfg(not(any(feature = "torus", feature = "plan")))]
 #[entry]
 fn main() -> ! {
-    static mut COLOR: [u16; PIXELS] = [0; PIXELS];
+    // Each pixel's slot in its scene's palette, two to a byte (`wraster_board::NibbleBand`).
+    static mut COLOR: [u8; PIXELS / 2] = [0; PIXELS / 2];
     static mut DEPTH: [u16; PIXELS] = [0; PIXELS];
     // The plane cache of the standard scenes (`wraster::mesh::PlaneCache`, `SceneCache` above): a triangle reaching
     // several bands is set up once a frame where it has room.
@@ -235,7 +250,7 @@ fn main() -> ! {
     // the same way (list frames with the plane cache), so the two lines differ by the bound alone.
     #[cfg(feature = "coarse")]
     let ok = ok
-        & run_all_cached::<Fast, _>(
+        & run_all_banded::<Fast, Nibbles, _>(
             "qemu-m0",
             "m0",
             COLOR,
