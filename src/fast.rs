@@ -1142,7 +1142,10 @@ fn fresh_run<const UP: bool, S: FreshSeed>(
     }
 }
 
-/// [`fresh_run`] over `row` (not empty), to its end ([`to_end`]).
+/// [`fresh_run`] over `row` (not empty), to its end: as [`to_end`], but the last pixel, where the run got to it, is
+/// taken here rather than by a second call beside a sentinel of its own: its reciprocal, code and step as the loop
+/// takes them (`r.v` and `r.lz` are the last pixel's: the loop stopped on it), so the same state as one loop over the
+/// row (a unit test compares them).
 #[inline(always)]
 fn fresh_to_end<const UP: bool, S: FreshSeed>(
     row: &mut [u16],
@@ -1151,11 +1154,37 @@ fn fresh_to_end<const UP: bool, S: FreshSeed>(
     lz: i32,
     frac: u32,
 ) -> FreshEnd {
-    to_end(
-        row,
-        |px| fresh_run::<UP, S>(px, v, dv, lz, frac),
-        |px, r| fresh_run::<UP, S>(px, r.v, r.dv, r.lz, frac),
-    )
+    let n = row.len();
+    let r = with_sentinel(row, |px| fresh_run::<UP, S>(px, v, dv, lz, frac));
+    let Some(last) = row.last_mut() else {
+        return r;
+    };
+    if r.end != End::Fail || r.k + 1 < n {
+        return r;
+    }
+    let (s, round) = Bin::shift::<UP>(frac, r.lz);
+    let c = (fresh::<UP, S>((r.v >> 32) as u32) as u32).wrapping_add(round) >> s;
+    if c >= u32::from(*last) {
+        return r;
+    }
+    // `c` is below a `u16`: it fits. Then the step past it, as the loop takes it.
+    *last = c as u16;
+    let (mut v, mut dv, mut lz) = (r.v.wrapping_add(r.dv as u64), r.dv, r.lz);
+    let mut end = End::Row;
+    if left_binade::<UP>(v) {
+        if UP && chains::<UP, S>(dv >> 1) {
+            end = End::Binade;
+        } else {
+            renormalise::<UP>(&mut v, &mut dv, &mut lz, &mut 0, &mut 0);
+        }
+    }
+    FreshEnd {
+        k: n,
+        v,
+        dv,
+        lz,
+        end,
+    }
 }
 
 /// A passing run over `row` (not empty), to its last pixel: `first` walks it to the pixel before the last, which is
