@@ -8,7 +8,7 @@ instructions each candidate costs on the board), then builds two firmwares and m
   and depth path; the depth buffer sized from the plan);
 - the general default: the same board's default build of that scene alone (`ONLY=<scene> --features size-probe`, or
   `--features torus,size-probe`): W16, the core's default strategy, the scene's own depth range, the board's own
-  buffers (the M4 a whole frame, the M0 12-row bands, 6 for the torus, with colour bands of half a byte a pixel).
+  buffers (the M4 a whole frame, the M0 15-row bands, 6 for the torus, with colour bands of half a byte a pixel).
 Per firmware: the library's `.text` (`text_share.py`: instructions whose DWARF source is this repository's `src/`,
 inlined code included), the whole `.text` and `.bss` (`llvm-size -A`), the depth RAM, the instructions per frame
 (the board's `bench` line, counted around the draw calls: `instructions`, or `instr_per_frame` for the torus's 8
@@ -21,9 +21,9 @@ import glob, os, re, subprocess, sys
 ROOT = os.path.realpath(os.path.join(os.path.dirname(__file__), '..', '..'))
 BOARDS = {'m4': ('qemu-m4', 'thumbv7em-none-eabihf', 'wraster-qemu-m4'),
           'm0': ('qemu-m0', 'thumbv6m-none-eabi', 'wraster-qemu-m0')}
-# The boards' own depth buffers (bytes): the M4's whole W16 frame; the M0's 12-row W16 bands (6 rows for the torus,
+# The boards' own depth buffers (bytes): the M4's whole W16 frame; the M0's 15-row W16 bands (6 rows for the torus,
 # whose 512 transformed vertices take most of its 16 KiB; its colour bands keep half a byte a pixel).
-DEFAULT_DEPTH = {('m4', False): 320 * 240 * 2, ('m0', False): 320 * 12 * 2, ('m4', True): 320 * 240 * 2,
+DEFAULT_DEPTH = {('m4', False): 320 * 240 * 2, ('m0', False): 320 * 15 * 2, ('m4', True): 320 * 240 * 2,
                  ('m0', True): 320 * 6 * 2}
 
 

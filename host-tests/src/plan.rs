@@ -79,7 +79,7 @@ impl Core {
     }
     /// The depth RAM a plan may take for scene `scene`: the M0 board's 16 KiB holds 8-row W16 bands (5,120 bytes)
     /// beside an RGB565 colour band, 4-row ones (2,560) for the torus, whose 512 transformed vertices take 6 KiB (a
-    /// plan's firmware keeps RGB565 colour; the default builds keep half a byte a pixel beside 12-row bands, 6 for
+    /// plan's firmware keeps RGB565 colour; the default builds keep half a byte a pixel beside 15-row bands, 6 for
     /// the torus); the M4 and RV32 boards hold a whole W16 frame (153,600 bytes).
     pub fn default_depth_ram(self, scene: &str) -> usize {
         match self {

@@ -1,7 +1,7 @@
 //! wraster on QEMU `microbit` (nRF51, Cortex-M0, 16 KiB RAM, thumbv6m-none-eabi), memory map in `memory.x`.
 //!
-//! The frame does not fit in RAM: every standard scene is rendered in 20 bands of 12 rows (a 320x12 colour band of
-//! half a byte a pixel, `wraster_board::NibbleBand`, and a 320x12 W16 band: 9,600 bytes), triangles binned by rows (see `wraster-board`), with this core's default (`Fast`), then
+//! The frame does not fit in RAM: every standard scene is rendered in 16 bands of 15 rows (a 320x15 colour band of
+//! half a byte a pixel, `wraster_board::NibbleBand`, and a 320x15 W16 band: 12,000 bytes), triangles binned by rows (see `wraster-board`), with this core's default (`Fast`), then
 //! the other strategies; one `bench` line per run over semihosting, exit 0; any error or panic exits non-zero.
 //! `--features torus` builds W4 instead (the rotating torus through the mesh path, 40 bands of 6 rows whose colour is
 //! a palette index a pixel, two to a byte: its 512 transformed vertices take 6 KiB of the 16, its row bins 1 KiB,
@@ -38,11 +38,16 @@ use {
     wraster::scenes::torus::{TRIANGLES, VERTICES},
 };
 
-/// Rows per band of the standard scenes: 12 (20 bands; 30 of 8 rows before), their colour band holding each pixel's
+/// Rows per band of the standard scenes: 15 (16 bands; 30 of 8 rows before), their colour band holding each pixel's
 /// slot in the scene's palette, two to a byte (`wraster_board::NibbleBand`; every standard scene has at most 13
-/// colours): 9,600 bytes with the W16 band, where 8 rows of RGB565 took 10,240.
+/// colours): 12,000 bytes with the W16 band, where 8 rows of RGB565 took 10,240, the plane cache giving up the rest
+/// (`SceneCache`). Measured (`--features size-probe`, default `Fast`), instructions for W1, W2, W3, terrain: 8 rows
+/// of RGB565 and 86 cached triangles 1,774,619, 8,899,428, 13,448,682, 13,121,805 (commit 2124873); 12 rows of half
+/// a byte and 86, 1,719,181, 8,335,556, 12,745,622, 12,582,244; 15 rows and 48, 1,703,433, 8,154,870, 12,370,936,
+/// 12,602,683 (commit 406cbb0's draw code). 12 rows with `--features coarse`, whose bound (one code per 8 pixels of
+/// each row) takes the room 15 would need.
 #[cfg(not(feature = "torus"))]
-const BAND_ROWS: usize = 12;
+const BAND_ROWS: usize = if cfg!(feature = "coarse") { 12 } else { 15 };
 /// With `--features torus` the 512 transformed vertices take 6 KiB, so the bands are 6 rows (40 bands, 4,800 bytes):
 /// W4's colours are eight palette entries, so its colour band holds a palette index a pixel, two to a byte
 /// (`wraster_board::NibbleBand`), not RGB565 (two bytes a pixel: 4 rows, 60 bands, 5,120 bytes). Taller bands set
@@ -56,20 +61,18 @@ const BAND_ROWS: usize = 6;
 const PIXELS: usize = WIDTH as usize * BAND_ROWS;
 const _: () = assert!((HEIGHT as usize).is_multiple_of(BAND_ROWS));
 
-/// The standard scenes' plane cache on this board: 86 triangles (2,432 bytes), which held W3's triangles across the
-/// edges of 8-row bands (64, the other boards' `SCENE_CACHE`, did not: W3 0.9% and the terrain 1.9% more
-/// instructions; 84 cost W3 0.25% more than 86; 112 saved nothing more: the terrain 0.06%). With 12-row bands the
-/// deepest stack keeps 1,620 bytes free (CI fails under 256); more slots measured 0.9% fewer instructions on W3 with
-/// 92, 104, 112 or 120 and none with 98, 126 or 134, which is the code's layout, not the cache's room: kept at 86.
-/// 64 with `--features coarse`, whose bound takes 960 bytes: 1,676 bytes free with `size-probe` (CI checks that build
-/// too).
+/// The standard scenes' plane cache on this board: 48 triangles (1,344 bytes), what the 15-row bands leave with the
+/// deepest stack 256 bytes from the statics (CI fails under 256; 56 left 52 bytes). With 8-row bands it held 86,
+/// which kept W3's triangles across the bands' edges (64, the other boards' `SCENE_CACHE`, cost W3 0.9% and the
+/// terrain 1.9% more instructions there). In 15-row bands 56 saved W3 0.3% more than 48. 64 with `--features
+/// coarse`, in 12-row bands beside its bound's 960 bytes (CI checks that build's stack too).
 #[cfg(not(feature = "torus"))]
 type SceneCache = wraster::mesh::PlaneCache<
     {
         if cfg!(feature = "coarse") {
             64
         } else {
-            86
+            48
         }
     },
 >;
@@ -93,9 +96,9 @@ fn all<R: SpanRecip>(
     )
 }
 
-/// The cost of banding, measured on this core: every scene drawn again in bands of half the height (40 of 6 rows);
-/// the extra instructions over the run in 20 bands, divided by the 20 extra bands, are what one band costs (triangle
-/// setup repeated for triangles spanning both halves, the span walk restarted, the binning test).
+/// The cost of banding, measured on this core: every scene drawn again in bands of half the height (35 of 7 rows,
+/// the last of 2); the extra instructions over the run in 16 bands, divided by the 19 extra bands, are what one band
+/// costs (triangle setup repeated for triangles spanning both halves, the span walk restarted, the binning test).
 #[cfg(not(any(feature = "size-probe", feature = "torus")))]
 fn band_overhead(
     color: &mut [u8],
