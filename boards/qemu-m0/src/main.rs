@@ -44,7 +44,7 @@ use {
 /// (`SceneCache`). Measured (`--features size-probe`, default `Fast`), instructions for W1, W2, W3, terrain: 8 rows
 /// of RGB565 and 86 cached triangles 1,774,619, 8,899,428, 13,448,682, 13,121,805 (commit 2124873); 12 rows of half
 /// a byte and 86, 1,719,181, 8,335,556, 12,745,622, 12,582,244; 15 rows and 48, 1,703,433, 8,154,870, 12,370,936,
-/// 12,602,683 (commit 406cbb0's draw code). 12 rows with `--features coarse`, whose bound (one code per 8 pixels of
+/// 12,602,683 (commit 406cbb0's draw code); 15 rows and 55, 1,703,183, 8,153,811, 12,334,061, 12,532,372. 12 rows with `--features coarse`, whose bound (one code per 8 pixels of
 /// each row) takes the room 15 would need.
 #[cfg(not(feature = "torus"))]
 const BAND_ROWS: usize = if cfg!(feature = "coarse") { 12 } else { 15 };
@@ -53,7 +53,8 @@ const BAND_ROWS: usize = if cfg!(feature = "coarse") { 12 } else { 15 };
 /// (`wraster_board::NibbleBand`), not RGB565 (two bytes a pixel: 4 rows, 60 bands, 5,120 bytes). Taller bands set
 /// up fewer triangles again, and the plane cache took the bytes left (`wraster_board::TORUS_CACHE`): W4's frame
 /// (default `Fast`, commit 2124873's draw code, the same hash) 8,461,874 instructions with RGB565 in 4 rows and 38
-/// cached triangles; 7,839,211 with a byte a pixel in 5 rows and 50; 7,597,535 with half a byte in 6 rows and 50.
+/// cached triangles; 7,839,211 with a byte a pixel in 5 rows and 50; 7,597,535 with half a byte in 6 rows and 50
+/// (7,564,325 with the later changes to the fills and the fast tier's runs, commit 22035f6).
 /// The same firmware given more RAM (`memory.x` at 4M, run in QEMU's mps2-an386: the same instructions), 38 cached
 /// triangles, `Fast` alone: 4 rows 8,396,060 a frame, 5 rows 7,907,768, 6 rows 7,576,783, 8 rows 7,145,757.
 #[cfg(feature = "torus")]
@@ -61,18 +62,19 @@ const BAND_ROWS: usize = 6;
 const PIXELS: usize = WIDTH as usize * BAND_ROWS;
 const _: () = assert!((HEIGHT as usize).is_multiple_of(BAND_ROWS));
 
-/// The standard scenes' plane cache on this board: 48 triangles (1,344 bytes), what the 15-row bands leave with the
-/// deepest stack 256 bytes from the statics (CI fails under 256; 56 left 52 bytes). With 8-row bands it held 86,
-/// which kept W3's triangles across the bands' edges (64, the other boards' `SCENE_CACHE`, cost W3 0.9% and the
-/// terrain 1.9% more instructions there). In 15-row bands 56 saved W3 0.3% more than 48. 64 with `--features
-/// coarse`, in 12-row bands beside its bound's 960 bytes (CI checks that build's stack too).
+/// The standard scenes' plane cache on this board: 55 triangles (1,540 bytes), what the 15-row bands leave with the
+/// deepest stack 256 bytes from the statics (CI fails under 256: 260 free; with the band loop inline, 48 left 276).
+/// With 8-row bands it held 86, which kept W3's triangles across the bands' edges (64, the other boards'
+/// `SCENE_CACHE`, cost W3 0.9% and the terrain 1.9% more instructions there). In 15-row bands 55 against 48: W3
+/// -0.3%, the terrain -0.6%. 64 with `--features coarse`, in 12-row bands beside its bound's 960 bytes (CI checks
+/// that build's stack too).
 #[cfg(not(feature = "torus"))]
 type SceneCache = wraster::mesh::PlaneCache<
     {
         if cfg!(feature = "coarse") {
             64
         } else {
-            48
+            55
         }
     },
 >;
