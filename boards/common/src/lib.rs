@@ -873,8 +873,8 @@ fn scene_line(
 
 /// Triangles a board's W4 plane cache holds ([`wraster::mesh::PlaneCache`]): those that reach the next band, and the
 /// previous band's until the walk meets them; a full cache only computes values again. 50 is what the M0's 16 KiB
-/// leave beside its 6-row bands of half a byte a pixel (its deepest stack then keeps 276 bytes free in the torus build
-/// and 260 in the `cull` build, over CI's 256), since the frame loop keeps its transform, its camera and its lines out
+/// leave beside its 6-row bands of half a byte a pixel (its deepest stack then keeps 284 bytes free in the torus build
+/// and 268 in the `cull` build, over CI's 256), since the frame loop keeps its transform, its camera and its lines out
 /// of line (`torus_frame`, `torus_view`, `torus_line`). Measured on the M0's W4 (default `Fast` alone, commit
 /// 2124873's draw code, its firmware given more RAM: `memory.x` at 4M, run in QEMU's mps2-an386, the same
 /// instructions): 5-row bands, 7,907,768 instructions a frame with 38, 7,747,448 with 49, 7,678,228 with 64,

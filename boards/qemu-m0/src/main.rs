@@ -5,7 +5,7 @@
 //! the other strategies; one `bench` line per run over semihosting, exit 0; any error or panic exits non-zero.
 //! `--features torus` builds W4 instead (the rotating torus through the mesh path, 40 bands of 6 rows whose colour is
 //! a palette index a pixel, two to a byte: its 512 transformed vertices take 6 KiB of the 16, its row bins 1 KiB,
-//! its plane cache 1,424 bytes, and the deepest stack of the run, 2.6 KiB, leaves 276 bytes free: `boards/tools/stackdepth.c`, which
+//! its plane cache 1,424 bytes, and the deepest stack of the run, 2.6 KiB, leaves 284 bytes free: `boards/tools/stackdepth.c`, which
 //! CI runs on this build and fails under 256); `--features cull` adds the bounding-sphere cull's line and RV32's default strategy (`FastDivInt`).
 //! Run: `cd boards/qemu-m0 && cargo run --release` (the runner in `.cargo/config.toml` adds `-icount shift=0`).
 //!
