@@ -147,7 +147,7 @@ impl Edge {
 /// directed edge `a -> b` at row `j`, relative to the pixel `(ox, oy)`; `None` for a horizontal edge. Shared with
 /// [`DivBound`].
 #[inline(always)]
-fn small_edge(a: Sub, b: Sub, j: i32, ox: i32, oy: i32) -> Option<(i32, i32, i32, i32)> {
+pub(crate) fn small_edge(a: Sub, b: Sub, j: i32, ox: i32, oy: i32) -> Option<(i32, i32, i32, i32)> {
     let (ax, ay) = (a.x - 256 * ox, a.y - 256 * oy);
     let (bx, by) = (b.x - 256 * ox, b.y - 256 * oy);
     let (a_, b_) = (ay - by, bx - ax);
