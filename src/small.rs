@@ -229,14 +229,13 @@ std::thread_local! {
 
 /// Edge `k -> k+1` of the oriented triangle `q` (relative to the box's origin pixel) at the centre of the origin
 /// column on the row whose centre is `cy` sub-pixels below the origin: its edge function `E` (`|E| < 2^28`, the
-/// module doc), `E` less its top-left bias (0 on a top or left edge, else 1), and its steps a column and a row.
+/// module doc; without the top-left bias, which only coverage takes: [`Halves`]), and its steps a column and a row.
 #[inline(always)]
-fn edge_at(q: &[(i32, i32); 3], k: usize, cy: i32) -> (i32, i32, i32, i32) {
+fn edge_at(q: &[(i32, i32); 3], k: usize, cy: i32) -> (i32, i32, i32) {
     let (a, c) = (q[k], q[(k + 1) % 3]);
     let (ea, eb) = (a.1 - c.1, c.0 - a.0);
     let er = ea * (128 - a.0) + eb * (cy - a.1);
-    let bias = i32::from(!(ea > 0 || (ea == 0 && eb > 0)));
-    (er, er - bias, ea << SUBPIXEL_BITS, eb << SUBPIXEL_BITS)
+    (er, ea << SUBPIXEL_BITS, eb << SUBPIXEL_BITS)
 }
 
 /// `K = 65535 2A = kn 2^kz` for the doubled area `area2` (below `2^29`: the box is under 32 x 126 px), `kn` in
@@ -315,7 +314,7 @@ fn constants<const KEEP: bool>(
     let mut er_m0 = [0i32; 3];
     for k in 0..3 {
         let er;
-        (er, _, ex[k], ey[k]) = edge_at(q, k, cy);
+        (er, ex[k], ey[k]) = edge_at(q, k, cy);
         #[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
         {
             er_m0[k] = er;
@@ -388,17 +387,6 @@ fn constants<const KEEP: bool>(
 /// is a library call of some 60 instructions, two a row). Both give exactly the pixels whose three edge functions are
 /// `>= 0` (the unit tests compare them).
 const ROWS_BY_DIVISION: bool = !cfg!(all(target_arch = "arm", not(target_has_atomic = "32")));
-
-/// A row's covered run `[lo, hi)` (columns of the frame; empty when `lo >= hi`), and the step to the next row.
-trait Runs {
-    fn run(&mut self, ox: i32) -> (i32, i32);
-    fn step(&mut self);
-    /// The first row of the second stretch (`i32::MAX`: one stretch), where [`Runs::second`] switches edges.
-    fn second_from(&self) -> i32 {
-        i32::MAX
-    }
-    fn second(&mut self) {}
-}
 
 /// Each row's covered run from the two edges that bound it: sorted by `y`, the triangle's rows above its middle
 /// vertex lie between the long edge (top to bottom vertex) and the top short edge, and the rows from it down between
@@ -482,7 +470,8 @@ impl<B: Bound> Halves<B> {
     }
 }
 
-impl<B: Bound> Runs for Halves<B> {
+impl<B: Bound> Halves<B> {
+    /// The current row's covered run `[lo, hi)` (columns of the frame; empty when `lo >= hi`).
     #[inline(always)]
     fn run(&mut self, ox: i32) -> (i32, i32) {
         (ox + self.l.lo(), ox + self.r.hi())
@@ -492,10 +481,12 @@ impl<B: Bound> Runs for Halves<B> {
         self.l.step();
         self.r.step();
     }
+    /// The first row of the second stretch (`i32::MAX`: one stretch), where [`Halves::second`] switches edges.
     #[inline(always)]
     fn second_from(&self) -> i32 {
         self.from
     }
+    /// The bottom short edge takes the top one's place.
     #[inline(always)]
     fn second(&mut self) {
         if self.next_right {
@@ -544,9 +535,9 @@ impl Bound for DivBound {
 /// the M0 (`Fast`, `--features size-probe`): W3 -4.7% (12,334,061 to 11,755,748 instructions), the terrain -9.3%,
 /// W4 -4.1% (60,126,781 to 57,634,223 over its 8 frames).
 ///
-/// Its column `k` (relative to the box's origin, in `[0, ncol]`, `ncol` the box's columns), its edge function less the bias there on the current
-/// row (`e`; below `2^30` in magnitude at any column of the box and one past it: the module doc's `2^29 + 2^28` and a
-/// column's step, below `2^23`), and its steps a column (`ex`, `256 A`) and a row (`ey`, `256 B`). The edge function
+/// Its column `k` (relative to the box's origin, in `[0, ncol]`, `ncol` the box's columns), its edge function
+/// less the bias there on the current row (`e`; below `2^30` in magnitude at any column of the box and one past it:
+/// the module doc's `2^29 + 2^28` and a column's step, below `2^23`), and its steps a column (`ex`, `256 A`) and a row (`ey`, `256 B`). The edge function
 /// grows to the right along a left edge (`ex > 0`), which admits the columns from
 /// `L = min {k in [0, ncol] : e(k) >= 0}` (`ncol` for none), and falls along a right edge (`ex < 0`), which admits those
 /// below `R = min {k in [0, ncol] : k = ncol or e(k) < 0}`. Both are where a monotone sequence changes sign, so
@@ -638,29 +629,29 @@ struct Walk {
 
 impl Walk {
     #[inline(always)]
-    fn rows<S: FreshSeed, D: DrawTarget, R: Runs>(
+    fn rows<S: FreshSeed, D: DrawTarget, B: Bound>(
         self,
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
-        runs: R,
+        runs: Halves<B>,
         color: D::Color,
     ) -> Result<Stats, Error> {
         match self.lz {
             // `S` walked pre-shifted by its leading zeros too (exact: the walk is exact modulo 2^64, and every covered
             // pixel's shifted `S` has its top bit set), so that each pixel's normalised `m` is the high word.
-            Some(lz) => self.rows_as::<S, D, R, true>(target, depth, runs, color, lz),
-            None => self.rows_as::<S, D, R, false>(target, depth, runs, color, 0),
+            Some(lz) => self.rows_as::<S, D, B, true>(target, depth, runs, color, lz),
+            None => self.rows_as::<S, D, B, false>(target, depth, runs, color, 0),
         }
     }
 
     /// [`Walk::rows`], with the leading zeros of `S` the same at every covered pixel (`SAME_LZ`, `lz0`; `S` walked
     /// pre-shifted by them) or found per pixel. The same bits either way: only where the work is done differs.
     #[inline(always)]
-    fn rows_as<S: FreshSeed, D: DrawTarget, R: Runs, const SAME_LZ: bool>(
+    fn rows_as<S: FreshSeed, D: DrawTarget, B: Bound, const SAME_LZ: bool>(
         self,
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
-        mut runs: R,
+        mut runs: Halves<B>,
         color: D::Color,
         lz0: u32,
     ) -> Result<Stats, Error> {
@@ -714,7 +705,7 @@ impl Walk {
                 }
             };
         }
-        // Rows in two stretches where the runs change edges between them ([`Runs::second`]): each loop then carries
+        // Rows in two stretches where the runs change edges between them ([`Halves::second`]): each loop then carries
         // only the bounds it steps (by division). The Cortex-M0's stepped bounds take one loop that switches at the
         // middle vertex's row: two loops doubled the row's code in every instantiation (its `.text` 8.3 KB larger)
         // and saved 0.3% of W3's and the terrain's instructions (W4 0.1% more).
