@@ -57,6 +57,11 @@ const BAND_ROWS: usize = if cfg!(feature = "coarse") { 12 } else { 15 };
 /// (7,564,325 with the later changes to the fills and the fast tier's runs, commit 22035f6).
 /// The same firmware given more RAM (`memory.x` at 4M, run in QEMU's mps2-an386: the same instructions), 38 cached
 /// triangles, `Fast` alone: 4 rows 8,396,060 a frame, 5 rows 7,907,768, 6 rows 7,576,783, 8 rows 7,145,757.
+/// Again on commit a1d1c39 (`ONLY=torus`, all four strategies, `Fast`'s line), rows and cached triangles against
+/// today's 6 and 50: 6 and 0 +25.9%, 6 and 70 -1.0%, 6 and 90 -1.2%; 8 and 0 +13.3%, 8 and 20 +1.8%, 8 and 50 -5.8%,
+/// 8 and 70 -6.5%; 10 and 0 +6.0%. The cache is worth more than taller bands: 8 rows pay only with some 30 or more
+/// triangles cached, and their 5.8% with 50 needs 1,600 bytes more than this RAM has (the deepest stack, 2,692 bytes,
+/// is mostly the torus run's frame, 888, and the mesh draw's, 1,216, whose locals LLVM already overlaps).
 #[cfg(feature = "torus")]
 const BAND_ROWS: usize = 6;
 const PIXELS: usize = WIDTH as usize * BAND_ROWS;
