@@ -66,13 +66,18 @@ impl Bin {
     /// (`g - 17 = X - 17 - s` in `[12, 31]`: no clamp, and `l - l / 2^13 >= 2^12`: no saturation); any other `s`
     /// takes [`Bin::general`], out of line (the same values: a unit test compares them over every `frac` and `lz`).
     /// Measured on the M4 (`FastDiv`, `--features size-probe`): W1 731,960 -> 724,800 instructions (-1.0%), W2
-    /// 4,266,320 -> 4,179,800 (-2.0%); RV32 W2 -1.3%; the M0 within 0.2%. ([`Bin::shift`], in `fresh_run`'s loop,
-    /// keeps its clamps inline: there the out-of-line call measured W1 +7%.)
+    /// 4,266,320 -> 4,179,800 (-2.0%); RV32 W2 -1.3%. The M0 keeps the general computation inline (below).
+    /// ([`Bin::shift`], in `fresh_run`'s loop, keeps its clamps inline: there the out-of-line call measured W1 +7%.)
     #[inline(always)]
     fn new<const UP: bool>(frac: u32, lz: i32) -> Bin {
         let x_bits = if UP { 60 } else { 61 };
         let s = x_bits + 16 - frac as i32 - lz;
-        if (s - 13) as u32 <= 18 {
+        if NO_WIDE {
+            // The Cortex-M0 keeps the general computation inline: the split measured within 0.2% there, and it
+            // grew the mesh draw's stack frame by 68 bytes (W4's deepest stack to 212 bytes from the statics, under
+            // CI's 256).
+            Bin::general_inline::<UP>(frac, lz)
+        } else if (s - 13) as u32 <= 18 {
             let l = 1u32 << (x_bits - 17 - s);
             Bin {
                 s: s as u32,
@@ -83,10 +88,15 @@ impl Bin {
             Bin::general::<UP>(frac, lz)
         }
     }
-    /// [`Bin::new`] for any `frac` and `lz`.
+    /// [`Bin::new`] for any `frac` and `lz`, out of line.
     #[cold]
     #[inline(never)]
     fn general<const UP: bool>(frac: u32, lz: i32) -> Bin {
+        Bin::general_inline::<UP>(frac, lz)
+    }
+    /// [`Bin::general`] inline.
+    #[inline(always)]
+    fn general_inline<const UP: bool>(frac: u32, lz: i32) -> Bin {
         let x_bits = if UP { 60 } else { 61 };
         let s = x_bits + 16 - frac as i32 - lz;
         // G = X - s; the exact code is 2^G / tau.
