@@ -1,10 +1,14 @@
 #!/usr/bin/env python3
-"""Estimated cycles beside the boards' instruction counts: `cycles.py BOARD [SCENE ...]` (BOARD qemu-m4 or qemu-m0;
-default scenes big overdraw small terrain). For each scene it builds the board with only the default strategy and only
-that scene (`--features size-probe`, `ONLY=<scene>`), runs it under QEMU with the insncount plugin (insncount.c in this
-folder; built here if missing), weights every executed instruction by its class from the core's timing table, and
-prints, last for each scene,
+"""Estimated cycles beside the boards' instruction counts: `cycles.py BOARD [--recip NAME] [--together] [SCENE ...]`
+(BOARD qemu-m4 or qemu-m0; default scenes big overdraw small terrain). For each scene it builds the board with only one
+strategy and only that scene (`--features size-probe`, `ONLY=<scene>`; the board's default strategy, or the one
+`--recip` names, by the build-time `RECIP`: fast, fast-div, lerp64 (the exact tier), prev-pixel, f32-div on the M4),
+runs it under QEMU with the insncount plugin (insncount.c in this folder; built here if missing), weights every
+executed instruction by its class from the core's timing table, and prints, last for each scene,
   cycles board=<b> scene=<s> instructions=<n> instr_per_px=.. instr_per_fragment=.. instr_per_tri=.. cpi=.. est_cycles_per_px=.. est_cycles_per_fragment=.. est_cycles_per_tri=..
+With `--together` it builds and runs the four scenes in one firmware instead and prints one line over them (the
+report's figures, instructions per written pixel over the four scenes):
+  cycles board=<b> recip=<r> scenes=4 instructions=<n> pixels=<p> instr_per_px=.. cpi=.. est_cycles_per_px=..
 `instructions` is the board's own count for the draw calls (its bench line); the estimate multiplies it by the
 cycles per instruction of the draw code (instructions outside the board crate, the start-up code, the clears and the
 formatting). These are ESTIMATES: QEMU counts instructions, not cycles; the tables do not model flash or RAM wait
@@ -22,8 +26,16 @@ from disasm import disassemble
 
 here = os.path.dirname(os.path.abspath(__file__))
 boards = os.path.dirname(here)
-board = sys.argv[1]
-scenes = sys.argv[2:] or ['big', 'overdraw', 'small', 'terrain']
+args = sys.argv[1:]
+board = args.pop(0)
+recip = None
+if '--recip' in args:
+    i = args.index('--recip')
+    recip = args[i + 1]
+    del args[i:i + 2]
+together = '--together' in args
+args = [a for a in args if a != '--together']
+scenes = args or ['big', 'overdraw', 'small', 'terrain']
 core = {'qemu-m4': 'm4', 'qemu-m0': 'm0p'}[board]
 target = {'m4': 'thumbv7em-none-eabihf', 'm0p': 'thumbv6m-none-eabi'}[core]
 qemu = {'m4': ['qemu-system-arm', '-cpu', 'cortex-m4', '-machine', 'mps2-an386'],
@@ -72,17 +84,24 @@ def cycles_of(mn, ops, taken):
     return 1
 
 
-for scene in scenes:
-    env = dict(os.environ, ONLY=scene, CARGO_TARGET_DIR='/tmp/wraster-cycles')
+def measure(only):
+    """Builds the board (one strategy; one scene, or all where `only` is None), runs it with the plugin: its `bench`
+    lines' fields and the cycles per instruction of its draw code."""
+    env = dict(os.environ, CARGO_TARGET_DIR='/tmp/wraster-cycles')
+    env.pop('ONLY', None)
+    env.pop('RECIP', None)
+    if only:
+        env['ONLY'] = only
+    if recip:
+        env['RECIP'] = recip
     subprocess.run(['cargo', 'build', '--release', '--quiet', '--features', 'size-probe'],
                    cwd=os.path.join(boards, board), env=env, check=True)
     elf = f'/tmp/wraster-cycles/{target}/release/wraster-{board}'
-    counts = f'/tmp/wraster-cycles-{board}-{scene}.txt'
+    counts = f'/tmp/wraster-cycles-{board}-{only or "all"}-{recip or "default"}.txt'
     out = subprocess.run(qemu + ['-nographic', '-icount', 'shift=0', '-semihosting-config', 'enable=on,target=native',
                                  '-kernel', elf, '-plugin', f'{plugin},out={counts}'],
                          capture_output=True, text=True, check=True).stdout
-    bench = [l for l in out.splitlines() if l.startswith('bench ')][0]
-    f = dict(kv.split('=', 1) for kv in bench.split()[1:])
+    benches = [dict(kv.split('=', 1) for kv in l.split()[1:]) for l in out.splitlines() if l.startswith('bench ')]
     dis, func, path = {}, {}, {}
     for a, text, f_, p, _ in disassemble(elf):
         parts = text.split('@')[0].split(None, 1)
@@ -104,7 +123,21 @@ for scene in scenes:
         taken = max(0.0, min(1.0, (c - fall) / c)) if c else 0.0
         ins += c
         cyc += c * cycles_of(mn, ops, taken)
-    cpi = cyc / ins
+    return benches, cyc / ins
+
+
+if together:
+    benches, cpi = measure(None)
+    n = sum(int(f['instructions']) for f in benches)
+    px = sum(int(f['pixels']) for f in benches)
+    names = {f['recip'] for f in benches}
+    print(f"cycles board={board} recip={'/'.join(sorted(names))} scenes={len(benches)} instructions={n} pixels={px} "
+          f"instr_per_px={n / px:.1f} cpi={cpi:.3f} est_cycles_per_px={n * cpi / px:.1f}", flush=True)
+    sys.exit(0)
+
+for scene in scenes:
+    benches, cpi = measure(scene)
+    f = benches[0]
     n = int(f['instructions'])
     px, fr, tri = int(f['pixels']), int(f['fragments']), int(f['triangles'])
     print(f"cycles board={board} scene={scene} instructions={n} instr_per_px={n / px:.1f} instr_per_fragment={n / fr:.1f} "

@@ -63,6 +63,12 @@ fn report_writes_its_tables_and_its_line_last() {
     for png in ["pareto.png", "step_10_10000.png", "terrain_error.png"] {
         assert!(dir.join(png).exists(), "{png}");
     }
+    // Estimated cycles beside the instructions (issue 10), in both tables (here without boards: no figures).
+    assert_eq!(
+        md.matches("| M4 instr/px | M4 est. cycles/px | M0 instr/px | M0 est. cycles/px |")
+            .count(),
+        2
+    );
     let row = |format: &str, strategy: &str| -> Vec<String> {
         md.lines()
             .find(|l| {

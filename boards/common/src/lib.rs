@@ -81,6 +81,52 @@ pub const PACKED: u8 = 2;
 /// takes): W4's torus; a standard scene is its index in [`SCENES`].
 pub const TORUS_SCENE: usize = usize::MAX;
 
+/// The strategy a `--features size-probe` build runs, named by the build-time `RECIP` (one strategy a firmware, for
+/// `boards/tools/cycles.py`'s estimated cycles of each; the report shows them): unset, the core's default
+/// ([`PROBE_DEFAULT`]); else [`PROBE_FAST`] (`fast`), [`PROBE_FAST_DIV`] (`fast-div`), [`PROBE_EXACT`] (`lerp64`, the
+/// exact tier), [`PROBE_PREV_PIXEL`] (`prev-pixel`) or [`PROBE_F32_DIV`] (`f32-div`), the names of the `bench` lines'
+/// `recip=`. Any other name fails the build. A constant, so a firmware links only the strategy it names.
+pub const PROBE_RECIP: u8 = probe_recip(option_env!("RECIP"));
+/// [`PROBE_RECIP`] unset: the core's default strategy.
+pub const PROBE_DEFAULT: u8 = 0;
+/// [`PROBE_RECIP`]: `fast`.
+pub const PROBE_FAST: u8 = 1;
+/// [`PROBE_RECIP`]: `fast-div`.
+pub const PROBE_FAST_DIV: u8 = 2;
+/// [`PROBE_RECIP`]: `lerp64` (the exact tier).
+pub const PROBE_EXACT: u8 = 3;
+/// [`PROBE_RECIP`]: `prev-pixel`.
+pub const PROBE_PREV_PIXEL: u8 = 4;
+/// [`PROBE_RECIP`]: `f32-div`.
+pub const PROBE_F32_DIV: u8 = 5;
+
+/// [`PROBE_RECIP`] from the name (a `const fn`: an unknown name is a build error).
+const fn probe_recip(name: Option<&str>) -> u8 {
+    const fn is(a: &str, b: &str) -> bool {
+        let (a, b) = (a.as_bytes(), b.as_bytes());
+        if a.len() != b.len() {
+            return false;
+        }
+        let mut i = 0;
+        while i < a.len() {
+            if a[i] != b[i] {
+                return false;
+            }
+            i += 1;
+        }
+        true
+    }
+    match name {
+        None => PROBE_DEFAULT,
+        Some(n) if is(n, "fast") => PROBE_FAST,
+        Some(n) if is(n, "fast-div") => PROBE_FAST_DIV,
+        Some(n) if is(n, "lerp64") => PROBE_EXACT,
+        Some(n) if is(n, "prev-pixel") => PROBE_PREV_PIXEL,
+        Some(n) if is(n, "f32-div") => PROBE_F32_DIV,
+        Some(_) => panic!("RECIP: one of fast, fast-div, lerp64, prev-pixel, f32-div"),
+    }
+}
+
 /// The plans named by `PLAN` at build time (none without it).
 pub mod plans {
     include!(concat!(env!("OUT_DIR"), "/plans.rs"));
@@ -1615,6 +1661,28 @@ mod tests {
 
     fn rgb(c: u16) -> Rgb565 {
         Rgb565::from(RawU16::new(c))
+    }
+
+    /// `RECIP` names the strategies by the `bench` lines' `recip=`; unset is the core's default; a prefix or a longer
+    /// name is no name (an unknown one fails the build: a `const` panic).
+    #[test]
+    fn probe_recip_reads_the_bench_names() {
+        assert_eq!(probe_recip(None), PROBE_DEFAULT);
+        for (name, want) in [
+            ("fast", PROBE_FAST),
+            ("fast-div", PROBE_FAST_DIV),
+            ("lerp64", PROBE_EXACT),
+            ("prev-pixel", PROBE_PREV_PIXEL),
+            ("f32-div", PROBE_F32_DIV),
+        ] {
+            assert_eq!(probe_recip(Some(name)), want, "{name}");
+        }
+        for bad in ["fas", "fast-di", "fast-divx", "exact", ""] {
+            assert!(
+                std::panic::catch_unwind(|| probe_recip(Some(bad))).is_err(),
+                "{bad}"
+            );
+        }
     }
 
     /// Every rectangle (inside, across every side, empty, far outside, from every column's parity) fills exactly its

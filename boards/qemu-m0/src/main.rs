@@ -255,7 +255,28 @@ fn main() -> ! {
         [0; wraster::bound_len(WIDTH as usize, BAND_ROWS)];
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 125, 2);
+    #[cfg(not(feature = "size-probe"))]
     let ok = all::<Fast>(COLOR, DEPTH, CACHE, &mut counter);
+    // `--features size-probe`: one strategy, the default unless the build-time `RECIP` names another
+    // (`wraster_board::PROBE_RECIP`: boards/tools/cycles.py estimates each strategy's cycles so; not `f32-div`, which
+    // this core would run in soft float). A constant: the firmware links only the strategy it runs.
+    #[cfg(feature = "size-probe")]
+    let ok = {
+        use wraster::recip::{Exact, FastDiv, PrevPixel};
+        use wraster_board::{
+            PROBE_EXACT, PROBE_F32_DIV, PROBE_FAST_DIV, PROBE_PREV_PIXEL, PROBE_RECIP,
+        };
+        const _: () = assert!(
+            PROBE_RECIP != PROBE_F32_DIV,
+            "RECIP=f32-div: the M4 board only"
+        );
+        match PROBE_RECIP {
+            PROBE_FAST_DIV => all::<FastDiv>(COLOR, DEPTH, CACHE, &mut counter),
+            PROBE_EXACT => all::<Exact>(COLOR, DEPTH, CACHE, &mut counter),
+            PROBE_PREV_PIXEL => all::<PrevPixel>(COLOR, DEPTH, CACHE, &mut counter),
+            _ => all::<Fast>(COLOR, DEPTH, CACHE, &mut counter),
+        }
+    };
     // `--features coarse`: the default again with a coarse depth bound (`bound=coarse` lines), same hashes; drawn
     // the same way (list frames with the plane cache), so the two lines differ by the bound alone.
     #[cfg(feature = "coarse")]

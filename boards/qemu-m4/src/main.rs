@@ -78,7 +78,25 @@ fn main() -> ! {
     let cp = cortex_m::Peripherals::take().unwrap();
     let mut counter = SysTick::new(cp.SYST, 40, 1);
     // This core's default: the fast tier seeded by its divide instruction.
+    #[cfg(not(feature = "size-probe"))]
     let ok = all::<FastDiv>(COLOR, DEPTH, VERTS, &mut counter);
+    // `--features size-probe`: one strategy, the default unless the build-time `RECIP` names another
+    // (`wraster_board::PROBE_RECIP`: boards/tools/cycles.py estimates each strategy's cycles so). A constant: the
+    // firmware links only the strategy it runs.
+    #[cfg(feature = "size-probe")]
+    let ok = {
+        use wraster::recip::{Exact, F32Div, Fast, PerPixel, PrevPixel};
+        use wraster_board::{
+            PROBE_EXACT, PROBE_F32_DIV, PROBE_FAST, PROBE_PREV_PIXEL, PROBE_RECIP,
+        };
+        match PROBE_RECIP {
+            PROBE_FAST => all::<Fast>(COLOR, DEPTH, VERTS, &mut counter),
+            PROBE_EXACT => all::<Exact>(COLOR, DEPTH, VERTS, &mut counter),
+            PROBE_PREV_PIXEL => all::<PrevPixel>(COLOR, DEPTH, VERTS, &mut counter),
+            PROBE_F32_DIV => all::<PerPixel<F32Div>>(COLOR, DEPTH, VERTS, &mut counter),
+            _ => all::<FastDiv>(COLOR, DEPTH, VERTS, &mut counter),
+        }
+    };
     // `--features size-probe` links the default path only, to measure the library's share of .text (README).
     // The other strategies run for the hash test: each strategy's frames agree across cores.
     #[cfg(not(feature = "size-probe"))]

@@ -3,7 +3,8 @@
 //! Every depth format x every W strategy (the reciprocal only matters to the W formats; the Z formats need none and
 //! appear once) over the standard scenes and the stiff suite, each measured against the f64 reference:
 //! depth error in LSBs of the format and relative to depth, visibility and coverage differences, host ns per drawn
-//! pixel (median of 15 runs), and the boards' instructions per pixel where the firmware runs that combination.
+//! pixel (median of 15 runs), and the boards' instructions per pixel where the firmware runs that combination, with
+//! estimated cycles beside them ([`board_cpis`]).
 //! Writes report/report.md and report/*.png; the last line is `report combos=<n> pareto=<k> out=report/report.md`.
 
 use std::fmt::Write as _;
@@ -448,6 +449,61 @@ fn board_figures(run: bool) -> (Vec<(String, String, f64)>, String) {
     (out, note)
 }
 
+/// Estimated cycles per instruction of each strategy's draw code on the two Cortex-M boards, for the strategies `boards`
+/// has figures of: `python3 boards/tools/cycles.py <board> --recip <name> --together` (its `cpi=`), which runs a build
+/// of the board with only that strategy (`--features size-probe`, the build-time `RECIP`) under QEMU with the
+/// insncount plugin and weights every executed instruction of the draw code by its class in the core's timing table
+/// (the Cortex-M4 and Cortex-M0+ Technical Reference Manuals). Estimates: no memory wait states, no pipeline effects
+/// beyond the branch penalty. (core, recip, cycles per instruction), and what the note says.
+fn board_cpis(boards: &[(String, String, f64)]) -> (Vec<(String, String, f64)>, String) {
+    let mut out = Vec::new();
+    if boards.is_empty() {
+        return (out, "estimated cycles not taken (no board figures)".into());
+    }
+    if !have("python3") {
+        return (
+            out,
+            "estimated cycles not taken: python3 is not installed".into(),
+        );
+    }
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../boards/tools/cycles.py");
+    let mut note = String::from("estimated cycles: the instructions times the cycles per instruction of the strategy's own single-strategy build (`boards/tools/cycles.py <board> --recip <name> --together`: each executed instruction weighted by its class in the Cortex-M4 and Cortex-M0+ Technical Reference Manuals' timing tables; no wait states, no pipeline effects beyond the branch penalty)");
+    for (core, recip, _) in boards {
+        let board = if core == "M4" { "qemu-m4" } else { "qemu-m0" };
+        if !["fast", "lerp64", "prev-pixel", "f32-div"].contains(&recip.as_str())
+            || (core == "M0" && recip == "f32-div")
+        {
+            continue;
+        }
+        let run = std::process::Command::new("python3")
+            .arg(&script)
+            .args([board, "--recip", recip, "--together"])
+            .output();
+        let cpi = run.as_ref().ok().and_then(|o| {
+            String::from_utf8_lossy(&o.stdout)
+                .lines()
+                .rev()
+                .find(|l| l.starts_with("cycles "))
+                .and_then(|l| field(l, "cpi").and_then(|v| v.parse::<f64>().ok()))
+        });
+        match cpi {
+            Some(cpi) => out.push((core.clone(), recip.clone(), cpi)),
+            None => {
+                let why = match &run {
+                    Ok(o) => String::from_utf8_lossy(&o.stderr)
+                        .lines()
+                        .last()
+                        .unwrap_or("")
+                        .to_string(),
+                    Err(e) => e.to_string(),
+                };
+                let _ = write!(note, "; cycles.py {board} {recip} failed: {why}");
+            }
+        }
+    }
+    (out, note)
+}
+
 fn main() {
     let run_boards = !std::env::args().any(|a| a == "--no-boards");
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../report");
@@ -525,10 +581,20 @@ fn main() {
     let pareto = combos.iter().filter(|c| c.pareto).count();
 
     let (boards, board_note) = board_figures(run_boards);
+    let (cpis, cycles_note) = board_cpis(&boards);
     let insn = |core: &str, key: Option<&str>| -> String {
         key.and_then(|k| boards.iter().find(|b| b.0 == core && b.1 == k))
             .map(|b| format!("{:.1}", b.2))
             .unwrap_or_else(|| "-".into())
+    };
+    // Estimated cycles per written pixel: the board's instructions times the strategy's cycles per instruction.
+    let cycles = |core: &str, key: Option<&str>| -> String {
+        key.and_then(|k| {
+            let b = boards.iter().find(|b| b.0 == core && b.1 == k)?;
+            let c = cpis.iter().find(|c| c.0 == core && c.1 == k)?;
+            Some(format!("{:.1}", b.2 * c.2))
+        })
+        .unwrap_or_else(|| "-".into())
     };
 
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
@@ -629,19 +695,19 @@ fn main() {
     // report.md
     let mut md = String::new();
     let _ = writeln!(md, "# Error against run time\n");
-    let _ = writeln!(md, "Made by `cargo run --release -p host-tests --bin report` on {cpu} ({cores} threads). Host times are medians of 15 runs of the four standard scenes (the draw calls alone, into a checked host framebuffer), in ns per written pixel. Board figures: {board_note}. QEMU counts instructions, not cycles.\n");
+    let _ = writeln!(md, "Made by `cargo run --release -p host-tests --bin report` on {cpu} ({cores} threads). Host times are medians of 15 runs of the four standard scenes (the draw calls alone, into a checked host framebuffer), in ns per written pixel. Board figures: {board_note}; {cycles_note}. QEMU counts instructions, not cycles: the cycles are estimates.\n");
     let _ = writeln!(md, "Errors are against the f64 reference (same snapped vertices and rules, its own arithmetic). LSB: |code - the format's f64 encode of the exact depth|. Relative: |decoded depth - exact depth| / depth, which includes the format's own quantisation. Only pixels where both agree on the visible surface count towards the depth error; the others are counted as visibility or coverage differences. The stiff suite draws each triangle alone (`Always`), so it has no visibility differences.\n");
     let _ = writeln!(
         md,
         "## Pareto front (host time against largest relative error)\n"
     );
-    let _ = writeln!(md, "| format | strategy | host ns/px | max rel. error | max LSB (scenes / stiff) | M4 instr/px | M0 instr/px |\n|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "| format | strategy | host ns/px | max rel. error | max LSB (scenes / stiff) | M4 instr/px | M4 est. cycles/px | M0 instr/px | M0 est. cycles/px |\n|---|---|---|---|---|---|---|---|---|");
     let mut front: Vec<&Combo> = combos.iter().filter(|c| c.pareto).collect();
     front.sort_by(|a, b| a.ns_px.total_cmp(&b.ns_px));
     for c in &front {
         let _ = writeln!(
             md,
-            "| {} | {} | {:.2} | {:.2e} | {} / {} | {} | {} |",
+            "| {} | {} | {:.2} | {:.2e} | {} / {} | {} | {} | {} | {} |",
             c.format,
             c.strategy,
             c.ns_px,
@@ -649,7 +715,9 @@ fn main() {
             c.scenes.max_lsb,
             c.stiff.max_lsb,
             insn("M4", c.board_key),
-            insn("M0", c.board_key)
+            cycles("M4", c.board_key),
+            insn("M0", c.board_key),
+            cycles("M0", c.board_key)
         );
     }
     let _ = writeln!(md, "\n![error against run time](pareto.png)\n");
@@ -667,11 +735,11 @@ fn main() {
         }
     }
     let _ = writeln!(md, "## Every combination\n");
-    let _ = writeln!(md, "| format | strategy | host ns/px | scenes: max / mean LSB | scenes: max / mean rel. | visibility diffs | coverage diffs | stiff: max LSB | stiff: max rel. | stiff coverage diffs | M4 instr/px | M0 instr/px | Pareto |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "| format | strategy | host ns/px | scenes: max / mean LSB | scenes: max / mean rel. | visibility diffs | coverage diffs | stiff: max LSB | stiff: max rel. | stiff coverage diffs | M4 instr/px | M4 est. cycles/px | M0 instr/px | M0 est. cycles/px | Pareto |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for c in &combos {
         let _ = writeln!(
             md,
-            "| {} | {} | {:.2} | {} / {:.4} | {:.2e} / {:.2e} | {} | {} | {} | {:.2e} | {} | {} | {} | {} |",
+            "| {} | {} | {:.2} | {} / {:.4} | {:.2e} / {:.2e} | {} | {} | {} | {:.2e} | {} | {} | {} | {} | {} | {} |",
             c.format,
             c.strategy,
             c.ns_px,
@@ -685,7 +753,9 @@ fn main() {
             c.stiff.max_rel,
             c.stiff.coverage,
             insn("M4", c.board_key),
+            cycles("M4", c.board_key),
             insn("M0", c.board_key),
+            cycles("M0", c.board_key),
             if c.pareto { "yes" } else { "" }
         );
     }
