@@ -1177,6 +1177,387 @@ mod tests {
         );
     }
 
+    /// [`t_at_snapped`]'s plane in `i128`, from the definitions: the depth-grid triangle's edges and doubled area
+    /// (0 for a degenerate one), the vertices' `T`, the gradient's numerators `(gx, gy)` and the snap's roundings
+    /// `r_k = p_k - q_k` on the depth grid.
+    struct Exact {
+        e1: (i128, i128),
+        e2: (i128, i128),
+        a: i128,
+        t: [i128; 3],
+        gx: i128,
+        gy: i128,
+        r: [(i128, i128); 3],
+    }
+
+    impl Exact {
+        fn of(s: &Setup) -> Exact {
+            let q = s.q.map(|q| (q.x as i128, q.y as i128));
+            let (e1, e2) = (
+                (q[1].0 - q[0].0, q[1].1 - q[0].1),
+                (q[2].0 - q[0].0, q[2].1 - q[0].1),
+            );
+            let t = s.t.map(|v| v as i128);
+            let (d1, d2) = (t[1] - t[0], t[2] - t[0]);
+            let up = s.dbits - SUBPIXEL_BITS;
+            let (ox, oy) = (s.dorigin.0 as i128 * 256, s.dorigin.1 as i128 * 256);
+            Exact {
+                e1,
+                e2,
+                a: e1.0 * e2.1 - e2.0 * e1.1,
+                t,
+                gx: d1 * e2.1 - d2 * e1.1,
+                gy: d2 * e1.0 - d1 * e2.0,
+                r: [0, 1, 2].map(|j| {
+                    (
+                        ((s.p[j].x as i128 - ox) << up) - q[j].0,
+                        ((s.p[j].y as i128 - oy) << up) - q[j].1,
+                    )
+                }),
+            }
+        }
+        fn t_min(&self) -> i128 {
+            self.t[0].min(self.t[1]).min(self.t[2])
+        }
+        /// The numerator over the area of vertex `j`'s correction.
+        fn num(&self, j: usize) -> i128 {
+            self.gx * self.r[j].0 + self.gy * self.r[j].1
+        }
+        /// The exact corrections `c_k = (gx rx_k + gy ry_k) / A`, truncated toward 0 (the area not 0).
+        fn c(&self) -> [i128; 3] {
+            [0, 1, 2].map(|j| self.num(j) / self.a)
+        }
+        /// Whether `out` is within `T_min 2^-35` of the exact values, vertex by vertex (compared without dividing).
+        fn within_bound(&self, out: [i64; 3]) -> bool {
+            let bound = (self.t_min() >> 35) * self.a.abs();
+            (0..3).all(|j| ((out[j] as i128 - self.t[j]) * self.a - self.num(j)).abs() <= bound)
+        }
+    }
+
+    /// Just below the limit on the corrections (`T_min / 2^9`: the largest exact `|c_k|` within `2^-19` of it,
+    /// found by bisecting one vertex's `1/W` over its `f32` bit patterns), the narrow way does not call the plane
+    /// steep (which would skip the wide way): it does so only when even its value less its errors is beyond the
+    /// limit by more than the wide way's error (`lim + lim / 2^19`). (The wide way may still decline there: it
+    /// bounds the two terms' magnitudes, `|gx rx| + |gy ry|`, not their sum.) Just above it, both ways
+    /// decline (beyond it by `2^-24`, above both ways' errors).
+    #[test]
+    fn t_at_snapped_answers_just_below_its_limit() {
+        let mut rnd = crate::xorshift(0xB15E_C7ED_0000_1111);
+        let mut unit = move || (rnd() >> 11) as f64 / (1u64 << 53) as f64;
+        let r = Rasterizer::<crate::recip::Fast>::new(RenderState::new(1.0, 100.0).unwrap());
+        let (mut below, mut above) = (0, 0);
+        for _ in 0..300 {
+            // A triangle of a pixel or two whose plane is steep (`T` doubling in about a pixel): its corrections near
+            // the limit for some `1/W` of vertex 1.
+            let (cx, cy, size) = (
+                40.0 + unit() * 100.0,
+                40.0 + unit() * 100.0,
+                0.3 + unit() * 2.0,
+            );
+            let v: [Vertex<()>; 3] = core::array::from_fn(|_| Vertex {
+                x: (cx + unit() * size) as f32,
+                y: (cy + unit() * size) as f32,
+                z: 0.0,
+                rhw: 0.5,
+                color: (),
+            });
+            // `ratio(bits)`: the largest |c_k| over the limit with vertex 1's `1/W` the f32 of these bits.
+            let ratio = |bits: u32| -> Option<(f64, Setup)> {
+                let mut v = v;
+                v[1].rhw = f32::from_bits(bits);
+                let s = r.setup(&v).ok().filter(|s| !s.on_grid)?;
+                let x = Exact::of(&s);
+                if x.a == 0 {
+                    return None;
+                }
+                let lim = x.t_min() >> 9;
+                Some((x.c().iter().map(|c| c.abs()).max()? as f64 / lim as f64, s))
+            };
+            // Bracket the limit between 1/W = 0.5 (a flat plane) and 0.5 / 30, then bisect the bit patterns.
+            let (mut lo, mut hi) = (0.5f32.to_bits(), (0.5f32 / 30.0).to_bits());
+            let (Some((r_lo, _)), Some((r_hi, _))) = (ratio(lo), ratio(hi)) else {
+                continue;
+            };
+            if !(r_lo < 1.0 && r_hi > 1.0) {
+                continue;
+            }
+            while lo.abs_diff(hi) > 1 {
+                let mid = (lo + hi) / 2;
+                match ratio(mid) {
+                    Some((x, _)) if x < 1.0 => lo = mid,
+                    Some(_) => hi = mid,
+                    None => break,
+                }
+            }
+            if let Some((x, s)) = ratio(lo) {
+                if x > 1.0 - 2f64.powi(-19) && x <= 1.0 {
+                    below += 1;
+                    assert!(
+                        !matches!(t_at_snapped_narrow(&s), Narrow::Steep),
+                        "{x}: steep below the limit"
+                    );
+                }
+            }
+            if let Some((x, s)) = ratio(hi) {
+                if x > 1.0 + 2f64.powi(-24) {
+                    above += 1;
+                    assert!(
+                        t_at_snapped::<true>(&s).is_none() && t_at_snapped::<false>(&s).is_none(),
+                        "{x}"
+                    );
+                }
+            }
+        }
+        std::println!("just below the limit {below}, just above {above}");
+        assert!(below >= 20 && above >= 20, "{below} {above}");
+    }
+
+    /// The wide way's decision ([`t_at_snapped_wide`]), against its stated rule evaluated in `i128`: it bounds each
+    /// vertex's correction by its two terms' magnitudes, `(|gx rx| + |gy ry|) / |A|`, and declines where that is
+    /// above `lim = T_min / 2^9` for some vertex (here: above it by `2^-20` and 4 units, beyond the way's errors, a
+    /// relative `2^-26.5` and a unit a term; terms of `2^62` or more among them) or, with every one below the limit
+    /// by as much, where a corrected `T` leaves `(0, 2^61)`; otherwise it answers, within `T_min 2^-35`. Counts in
+    /// `seen` which of these it met: answered, beyond the limit (with terms of 2^62 or more), past 2^61.
+    fn wide_decides(s: &Setup, seen: &mut [u32]) {
+        let w = t_at_snapped_wide(s);
+        let x = Exact::of(s);
+        if x.a == 0 {
+            assert!(w.is_none());
+            return;
+        }
+        let (a, t, lim) = (x.a, x.t, x.t_min() >> 9);
+        // Each vertex's two terms' magnitudes over the area (rounded up) and its exact correction.
+        let m =
+            x.r.map(|(rx, ry)| ((x.gx * rx).abs() + (x.gy * ry).abs() + a.abs() - 1) / a.abs());
+        let c = x.c();
+        let margin = |v: i128| (v >> 20) + 4;
+        if m.iter().any(|&m| m > lim + margin(lim)) {
+            assert!(
+                w.is_none(),
+                "a correction's terms beyond the limit, and it answered"
+            );
+            seen[1] += 1;
+            if m.iter().any(|&m| m >= 1 << 62) {
+                seen[2] += 1;
+            }
+            return;
+        }
+        if m.iter().any(|&m| m >= lim - margin(lim)) {
+            return;
+        }
+        let v = [0, 1, 2].map(|j| t[j] + c[j]);
+        if v.iter()
+            .any(|&v| v >= (1 << 61) + (1 << 40) || v <= -(1 << 40))
+        {
+            if v.iter()
+                .all(|&v| v >= (1 << 61) + (1 << 40) || (v > 1 << 40 && v < (1 << 61) - (1 << 40)))
+            {
+                assert!(w.is_none(), "a value past 2^61, and it answered");
+                seen[3] += 1;
+            }
+            return;
+        }
+        if v.iter().all(|&v| v > 1 << 40 && v < (1 << 61) - (1 << 40)) {
+            let out = w.expect("every correction below the limit, and it declined");
+            assert!(x.within_bound(out));
+            seen[0] += 1;
+        }
+    }
+
+    /// The narrow way's decision is its stated rule, evaluated here in `i128` (no 32-bit pieces, no shift that could
+    /// overflow): it declines ([`Narrow::Unsure`]) where the area is 0, where `T_min < 2^40`, and where its
+    /// truncations' bound fails, `2^sd (2^su + W) R > |A| 2^(lt - 36)` (`sd`, `su` the shifts that bring the `T`
+    /// differences and the gradient's numerators to 31 bits, `W` and `R` the edges' and roundings' sums, `T_min >=
+    /// 2^lt`: [`t_at_snapped_narrow`]). Where the bound holds, vertex by vertex: an exact correction beyond its limit
+    /// `lim = T_min / 2^9` by `2^-9` makes it steep ([`Narrow::Steep`]); one below its acceptance `lim - lim / 2^8`
+    /// by `2^-9` that takes `T` past `2^61` makes it decline; if every one is below that and keeps `T` inside, it
+    /// answers, within `T_min 2^-35` of the exact value (between those margins either may be right). Random
+    /// off-grid triangles from 0.1 to 200 px and slivers, with planes from flat (equal `1/W`, some through
+    /// vertices at whole pixels but for half a sub-pixel: the bound's `k >= 0` side, where `|A| 2^k` passes `2^64`)
+    /// to steep, at far/near 100, 10^4 and 10^7, some beyond the far plane; some with the largest `T` within
+    /// `2^-12` of `2^61`; and large triangles on the snap grid but for one ulp, from the near plane to 2^20 to 2^23
+    /// times farther (`T_min < 2^40`, where only that test declines them).
+    #[test]
+    fn t_at_snapped_narrow_decides_by_its_stated_bound() {
+        let bits = |v: u128| 128 - v.leading_zeros() as i32;
+        let mut rnd = crate::xorshift(0x7A11_5EED_0B0D_D5ED);
+        let mut unit = move || (rnd() >> 11) as f64 / (1u64 << 53) as f64;
+        // Which sides of the rule the triangles reached: declined for small `T`, for the bound with `k >= 0` and
+        // with `k < 0` (of which beyond 2^64 before the area's scale), answered with `k >= 0` and `k < 0` (with a
+        // correction above half the limit), steep, and declined past 2^61; then the wide way's (`wide_decides`).
+        let mut seen = [0u32; 13];
+        for (far, w_hi, grid) in [
+            (100.0f64, 99.0, false),
+            (1e4, 2e4, false),
+            (1e7, 3e7, false),
+            (1e7, 3e7, true),
+        ] {
+            let r =
+                Rasterizer::<crate::recip::Fast>::new(RenderState::new(1.0, far as f32).unwrap());
+            for k in 0..20_000 {
+                let size = [0.1, 2.0, 20.0, 200.0][k % 4] * (0.5 + unit());
+                let (cx, cy) = (40.0 + unit() * 100.0, 40.0 + unit() * 100.0);
+                let mut v: [Vertex<()>; 3] = core::array::from_fn(|_| Vertex {
+                    x: (cx + unit() * size) as f32,
+                    y: (cy + unit() * size) as f32,
+                    z: 0.0,
+                    rhw: 0.0,
+                    color: (),
+                });
+                if k % 5 == 0 {
+                    let f = unit();
+                    v[2].x = v[0].x + (v[1].x - v[0].x) * f as f32 + [0.01, 0.003, 0.0004][k % 3];
+                    v[2].y = v[0].y + (v[1].y - v[0].y) * f as f32;
+                }
+                // W from 1.5 to `w_hi` (beyond the far plane for the last two), within a spread of 10^-5 to 30x.
+                let w = 1.5 + unit() * (w_hi - 1.5);
+                let spread = [0.0, 1e-5, 1e-3, 0.03, 1.0, 30.0][(k / 4) % 6];
+                for vk in v.iter_mut() {
+                    vk.rhw = (1.0 / (w * (1.0 + unit() * spread))) as f32;
+                    if spread == 0.0 && k % 3 == 0 {
+                        // A flat plane through vertices half a sub-pixel off whole pixel centres: edges of whole
+                        // pixels, so the area's low bits are zeros (`|A| 2^k` passes 2^64 with nothing left below).
+                        vk.x = vk.x.floor() + 0.5 + 1.0 / 512.0;
+                        vk.y = vk.y.floor() + 0.5 + 1.0 / 512.0;
+                    }
+                }
+                if k % 5 == 0 && k % 2 == 0 {
+                    // A plane steep along the sliver and flat across it (1/W affine on the screen): its gradient
+                    // across the sliver is large, so corrections near and beyond the limit.
+                    let f = ((v[2].x - v[0].x) / (v[1].x - v[0].x)).clamp(0.0, 1.0);
+                    v[0].rhw = 1.0 / 2.0;
+                    v[1].rhw = 1.0 / (2.0 + unit() as f32 * 60.0);
+                    v[2].rhw = v[0].rhw + (v[1].rhw - v[0].rhw) * f;
+                }
+                if grid {
+                    // Large triangles on the snap grid but for one ulp of one coordinate, from the near plane to
+                    // 2^20 to 2^23 times farther: `T_min < 2^40` with roundings so small that the truncations'
+                    // bound holds, the case the `T_min` test alone declines.
+                    let (gx, gy, size) = (unit() * 2000.0, unit() * 2000.0, 250.0 + unit() * 500.0);
+                    for vk in v.iter_mut() {
+                        vk.x = (((gx + unit() * size) * 256.0).round() / 256.0 - 2000.0) as f32;
+                        vk.y = (((gy + unit() * size) * 256.0).round() / 256.0 - 2000.0) as f32;
+                    }
+                    v[2].x = f32::from_bits(v[2].x.to_bits() + 1);
+                    v[0].rhw = 1.0 / 1.5;
+                    v[1].rhw = (1.0 / (1.5 * 2f64.powf(20.0 + 3.0 * unit()))) as f32;
+                    v[2].rhw = (1.0 / (1.5 * 2f64.powf(23.0 * unit()))) as f32;
+                }
+                if k % 11 == 5 && !grid {
+                    // The largest `t` just below a power of two, so its `T` within 2^-12 of 2^61, and a steep
+                    // plane: a correction that takes it past 2^61 (which the way declines).
+                    v[0].rhw = (7.998 / far) as f32;
+                    v[1].rhw = v[0].rhw * (0.3 + 0.7 * unit()) as f32;
+                    v[2].rhw = v[0].rhw * (0.3 + 0.7 * unit()) as f32;
+                }
+                if far > 1e6 && k % 7 == 3 && !grid {
+                    // `T` is scaled to each triangle's largest, so `T_min < 2^40` takes a ratio of 2^21 in one
+                    // triangle: from the near plane to beyond the far one (ratios from 2^10 to 2^23 here; the
+                    // bound's products pass 2^64 below 2^21).
+                    v[0].rhw = 1.0 / 1.5;
+                    v[1].rhw = (1.0 / (1.5 * 2f64.powf(10.0 + 13.0 * unit()))) as f32;
+                }
+                let Ok(s) = r.setup(&v) else { continue };
+                if s.on_grid {
+                    continue;
+                }
+                let n = t_at_snapped_narrow(&s);
+                let x = Exact::of(&s);
+                let (e1, e2, a, t, t_min) = (x.e1, x.e2, x.a, x.t, x.t_min());
+                wide_decides(&s, &mut seen[9..]);
+                if a == 0 || t_min < 1 << 40 {
+                    assert!(matches!(n, Narrow::Unsure), "{far} {k}: T_min {t_min}");
+                    seen[0] += 1;
+                    continue;
+                }
+                let lt = bits(t_min as u128) - 1;
+                let (d1, d2) = (t[1] - t[0], t[2] - t[0]);
+                let sd = (bits(d1.unsigned_abs().max(d2.unsigned_abs())) - 30).max(0);
+                let (dd1, dd2) = (d1 >> sd, d2 >> sd);
+                let (g1, g2) = (dd1 * e2.1 - dd2 * e1.1, dd2 * e1.0 - dd1 * e2.0);
+                let su = (bits(g1.unsigned_abs().max(g2.unsigned_abs())) - 30).max(0);
+                let rr = x.r.iter().map(|r| r.0.abs() + r.1.abs()).max().unwrap();
+                let wsum = (e1.1.abs() + e2.1.abs()).max(e1.0.abs() + e2.0.abs());
+                let lhs = (1i128 << sd) * ((1i128 << su) + wsum) * rr;
+                let kk = lt - 36;
+                let fits = if kk >= 0 {
+                    lhs <= a.abs() << kk
+                } else {
+                    lhs << -kk <= a.abs()
+                };
+                let k_side = lt - 36 - sd >= 0;
+                if !fits {
+                    assert!(matches!(n, Narrow::Unsure), "{far} {k}: the bound fails");
+                    seen[if k_side { 1 } else { 2 }] += 1;
+                    if !k_side
+                        && bits(((1u128 << su) + wsum as u128) * rr as u128) - (lt - 36 - sd) >= 64
+                    {
+                        seen[3] += 1;
+                    }
+                    continue;
+                }
+                // The exact corrections against the limit `lim = T_min / 2^9`, vertex by vertex as the way goes:
+                // one clearly above it (by 2^-9, far beyond the way's own error of about 2^-27 of it) is steep;
+                // below its acceptance `ok = lim - lim / 2^8` by as much, with the value well inside `(0, 2^61)`,
+                // the way goes on; at the end it answers, within `T_min 2^-35`. In between, either may be right.
+                let c = x.c();
+                let lim = t_min >> 9;
+                let ok = lim - (lim >> 8);
+                // Answers (`Some(0)`), steep (`Some(1)`), declines (`Some(2)`: a value past 2^61), or either.
+                let mut expect = Some(0);
+                for j in 0..3 {
+                    if c[j].abs() > lim + (lim >> 9) {
+                        expect = Some(1);
+                        break;
+                    }
+                    let clear = c[j].abs() < ok - (ok >> 9);
+                    if clear && t[j] + c[j] >= (1 << 61) + (1 << 40) {
+                        expect = Some(2);
+                        break;
+                    }
+                    let in_range = t[j] + c[j] > 1 << 20 && t[j] + c[j] < (1 << 61) - (1 << 40);
+                    if !(clear && in_range) {
+                        expect = None;
+                        break;
+                    }
+                }
+                match expect {
+                    Some(0) => {
+                        let Narrow::Done(out) = n else {
+                            panic!("{far} {k}: the bound holds, the corrections are below the limit, and it declined");
+                        };
+                        assert!(x.within_bound(out), "{far} {k}");
+                        seen[if k_side { 4 } else { 5 }] += 1;
+                        if c.iter().any(|c| c.abs() > lim / 2) {
+                            seen[6] += 1;
+                        }
+                    }
+                    Some(1) => {
+                        assert!(
+                            matches!(n, Narrow::Steep),
+                            "{far} {k}: a correction beyond the limit, not steep"
+                        );
+                        seen[7] += 1;
+                    }
+                    Some(_) => {
+                        assert!(
+                            matches!(n, Narrow::Unsure),
+                            "{far} {k}: a value past 2^61, not declined"
+                        );
+                        seen[8] += 1;
+                    }
+                    None => {}
+                }
+            }
+        }
+        std::println!(
+            "declined for T {}, for the bound {} / {} ({} beyond 2^64), answered {} / {} ({} above half the limit), steep {}, past 2^61 {}; the wide way: answered {}, beyond the limit {} (terms of 2^62 or more {}), past 2^61 {}",
+            seen[0], seen[1], seen[2], seen[3], seen[4], seen[5], seen[6], seen[7], seen[8], seen[9], seen[10], seen[11], seen[12]
+        );
+        // Every side of the rule was reached.
+        assert!(seen.iter().all(|&n| n > 0), "{seen:?}");
+    }
+
     /// The 32-bit targets' division equals `u128` division, on all of its paths and at their boundaries.
     #[test]
     fn div_u128_matches_u128_division() {

@@ -743,3 +743,51 @@ pub(crate) fn slope_bias(state: &RenderState, p: &[Sub; 3], c: [f32; 3], max: f3
     let r = if off >= 0.0 { off + 0.5 } else { off - 0.5 };
     r.clamp(-max, max) as i32
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`sar_to_i32`] is `floor(v / 2^s)` on its whole stated domain (`s <= 40`, the result an `i32`): each of its
+    /// three ways (no shift, the high word alone from 32 on, the two words between) against the 64-bit shift.
+    #[test]
+    fn sar_to_i32_is_the_floor_shift() {
+        let mut rnd = crate::xorshift(0x0DDB_A11C_AFE5_EED5);
+        for k in 0..200_000u64 {
+            let s = (k % 41) as u32;
+            // A value whose quotient fits an i32: a random i32 shifted back up, plus a remainder below 2^s.
+            let q = rnd() as i32 as i64;
+            let rem = if s == 0 {
+                0
+            } else {
+                (rnd() >> (64 - s)) as i64
+            };
+            // (From `s = 32` on every `i64` has such a quotient: the shift may drop `q`'s top bits.)
+            let v = (q << s).wrapping_add(rem);
+            assert_eq!(sar_to_i32(v, s), (v >> s) as i32, "{v} >> {s}");
+        }
+        // The ends: the largest and smallest quotients, with and without a remainder.
+        for s in 0..=40u32 {
+            let (hi, lo) = (
+                (i32::MAX as i64).min(i64::MAX >> s) << s,
+                (i32::MIN as i64).max(i64::MIN >> s) << s,
+            );
+            for v in [-1, 0, 1, hi, hi | ((1 << s) - 1), lo, lo | ((1 << s) - 1)] {
+                assert_eq!(sar_to_i32(v, s), (v >> s) as i32, "{v} >> {s}");
+            }
+        }
+    }
+
+    /// [`shr_u64`] is `floor(v / 2^s)` for every `s`, 0 from 64 on.
+    #[test]
+    fn shr_u64_is_the_shift_for_any_count() {
+        let mut rnd = crate::xorshift(0x005E_ED0F_5A1F_u64);
+        for s in 0..=200u32 {
+            for _ in 0..200 {
+                let v = rnd() >> (rnd() % 64);
+                assert_eq!(shr_u64(v, s), v.checked_shr(s).unwrap_or(0), "{v} >> {s}");
+            }
+            assert_eq!(shr_u64(u64::MAX, s), u64::MAX.checked_shr(s).unwrap_or(0));
+        }
+    }
+}
