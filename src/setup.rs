@@ -778,6 +778,91 @@ mod tests {
         }
     }
 
+    /// [`depth_plane`] accepts exactly where its stated rule holds, `(|gx| + |gy|) r <= 2^61 |A|` (the gradient's
+    /// numerators and the area from the depth-grid triangle, `r` the largest coordinate of the snap's roundings,
+    /// all formed here from the definitions in `i128`), and otherwise names the fewest extra bits `e` with a margin:
+    /// `lhs < rhs 2^(e - 1)`, and not more than 3 bits beyond the fewest that would do. Random triangles on the
+    /// depth grid from slivers to 100 px, with `T` up to `2^61` and planes from flat to steep, so that both sides
+    /// of the rule are met.
+    #[test]
+    fn depth_plane_accepts_by_its_stated_rule() {
+        let mut rnd = crate::xorshift(0xDE97_0B1A_7E00_5EED);
+        let (mut ok, mut shifted) = (0u32, 0u32);
+        for k in 0..100_000u64 {
+            let bits = 17 + (rnd() % 13) as u32; // 17 to 29 fraction bits
+            let up = bits - SUBPIXEL_BITS;
+            let size = 1i64 << (rnd() % (31 - bits) as u64).min(7); // up to 128 px, positions below 2^30 units
+            let origin = ((rnd() % 200) as i32, (rnd() % 200) as i32);
+            // Depth-grid positions relative to the origin pixel, within `size` pixels; the snapped ones their
+            // rounding to 1/256 px (absolute sub-pixels).
+            let mut pos = || (rnd() % ((size as u64) << (bits - 1))) as i64;
+            let mut q = [0; 3].map(|_| Sub {
+                x: pos() as i32,
+                y: pos() as i32,
+            });
+            if k % 3 == 0 {
+                // A sliver: the third vertex near the line through the first two.
+                let f = (rnd() % 1024) as i64;
+                let off = 1 + (rnd() % 64) as i64;
+                q[2].x = (q[0].x as i64 + (q[1].x as i64 - q[0].x as i64) * f / 1024 + off)
+                    .min(i32::MAX as i64) as i32;
+                q[2].y = (q[0].y as i64 + (q[1].y as i64 - q[0].y as i64) * f / 1024) as i32;
+            }
+            let snap =
+                |v: i32, o: i32| ((v as i64 + (1 << (up - 1))) >> up) as i32 + (o << SUBPIXEL_BITS);
+            let p = q.map(|q| Sub {
+                x: snap(q.x, origin.0),
+                y: snap(q.y, origin.1),
+            });
+            let top = 1i64 << (40 + rnd() % 21); // T up to 2^61
+            let spread = top >> (rnd() % 40);
+            let t = [0; 3].map(|_| top - (rnd() % spread as u64) as i64);
+            // The rule, from the definitions.
+            let (e1, e2) = (
+                ((q[1].x - q[0].x) as i128, (q[1].y - q[0].y) as i128),
+                ((q[2].x - q[0].x) as i128, (q[2].y - q[0].y) as i128),
+            );
+            let area = e1.0 * e2.1 - e2.0 * e1.1;
+            let got = depth_plane(&p, &q, &t, bits, origin);
+            if area == 0 {
+                assert_eq!(got, Err(None));
+                continue;
+            }
+            let (d1, d2) = (t[1] as i128 - t[0] as i128, t[2] as i128 - t[0] as i128);
+            let (gx, gy) = (d1 * e2.1 - d2 * e1.1, d2 * e1.0 - d1 * e2.0);
+            let r = (0..3)
+                .map(|j| {
+                    let rx = ((p[j].x as i128 - ((origin.0 as i128) << SUBPIXEL_BITS)) << up)
+                        - q[j].x as i128;
+                    let ry = ((p[j].y as i128 - ((origin.1 as i128) << SUBPIXEL_BITS)) << up)
+                        - q[j].y as i128;
+                    rx.abs().max(ry.abs())
+                })
+                .max()
+                .unwrap();
+            let (lhs, rhs) = ((gx.abs() + gy.abs()) * r, area.abs() << 61);
+            match got {
+                Ok(a) => {
+                    assert!(lhs <= rhs, "{k}: accepted beyond the rule");
+                    assert_eq!(a as i128, area);
+                    ok += 1;
+                }
+                Err(Some(e)) => {
+                    assert!(lhs > rhs, "{k}: declined within the rule");
+                    assert!(lhs < rhs << (e - 1), "{k}: {e} extra bits are too few");
+                    assert!(
+                        e < 3 || lhs >= rhs << (e - 3),
+                        "{k}: {e} extra bits are more than needed"
+                    );
+                    shifted += 1;
+                }
+                Err(None) => panic!("{k}: degenerate, with area {area}"),
+            }
+        }
+        std::println!("accepted {ok}, shifted {shifted}");
+        assert!(ok > 1000 && shifted > 1000, "{ok} {shifted}");
+    }
+
     /// [`shr_u64`] is `floor(v / 2^s)` for every `s`, 0 from 64 on.
     #[test]
     fn shr_u64_is_the_shift_for_any_count() {
