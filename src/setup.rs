@@ -863,6 +863,107 @@ mod tests {
         assert!(ok > 1000 && shifted > 1000, "{ok} {shifted}");
     }
 
+    /// [`Plane::solve_fast`] answers exactly where its stated rule holds (`T_min >= 2^51`, `|gx| + |gy| <= T_min /
+    /// 2^5` and each `|g| < 2A 2^38`, with `g` the gradient's numerators of `T' = round(T / 2^16)`, formed here in
+    /// `i128`), and then its plane is within `T_min 2^-33` (the exact solve's bound, which it stands in for) of the
+    /// exact plane through the vertices at every pixel centre in the triangle. Random triangles under 127 px
+    /// on the snap grid, with `T` from `2^48` to `2^61` and planes from flat to beyond the rule.
+    #[test]
+    fn solve_fast_answers_by_its_rule_within_its_bound() {
+        let mut rnd = crate::xorshift(0x50F7_FA57_0000_D1CE);
+        let (mut answered, mut declined) = (0u32, 0u32);
+        for k in 0..20_000u64 {
+            let size = 1 + (rnd() % 127) as i32;
+            let (x0, y0) = (256 * (rnd() % 100) as i32, 256 * (rnd() % 100) as i32);
+            let mut p = [0; 3].map(|_| Sub {
+                x: x0 + (rnd() % (256 * size as u64)) as i32,
+                y: y0 + (rnd() % (256 * size as u64)) as i32,
+            });
+            let cross = |p: &[Sub; 3]| {
+                (p[1].x - p[0].x) as i64 * (p[2].y - p[0].y) as i64
+                    - (p[2].x - p[0].x) as i64 * (p[1].y - p[0].y) as i64
+            };
+            if cross(&p) < 0 {
+                p.swap(1, 2);
+            }
+            let area = cross(&p);
+            if area == 0 {
+                continue;
+            }
+            let top = 1i64 << (48 + rnd() % 13);
+            let spread = (top >> [2, 6, 10, 20, 40][(k % 5) as usize]).max(1);
+            let v = [0; 3].map(|_| top - (rnd() % spread as u64) as i64);
+            let (xmin, ymin) = (
+                p.iter().map(|p| p.x).min().unwrap(),
+                p.iter().map(|p| p.y).min().unwrap(),
+            );
+            let (xmax, ymax) = (
+                p.iter().map(|p| p.x).max().unwrap(),
+                p.iter().map(|p| p.y).max().unwrap(),
+            );
+            let (j_ref, j0) = (ymin >> 8, (ymin >> 8) + (rnd() % 3) as i32);
+            let g = Geom {
+                p,
+                area,
+                dq: p,
+                darea: area,
+                dbits: SUBPIXEL_BITS,
+                dorigin: (0, 0),
+                i_ref: (xmin >> 8) as i64,
+                j_ref,
+                j0,
+            };
+            // The rule, from the definitions.
+            let t_min = v[0].min(v[1]).min(v[2]) as i128;
+            let tp = v.map(|t| ((t as i128) + (1 << 15)) >> 16);
+            let (e1, e2) = (
+                ((p[1].x - p[0].x) as i128, (p[1].y - p[0].y) as i128),
+                ((p[2].x - p[0].x) as i128, (p[2].y - p[0].y) as i128),
+            );
+            let (d1, d2) = (tp[1] - tp[0], tp[2] - tp[0]);
+            let (gx, gy) = (d1 * e2.1 - d2 * e1.1, d2 * e1.0 - d1 * e2.0);
+            let rule = t_min >= 1 << 51
+                && gx.abs() + gy.abs() <= t_min >> 5
+                && gx.abs() < (area as i128) << 38
+                && gy.abs() < (area as i128) << 38;
+            let got = Plane::solve_fast(v, &g);
+            assert_eq!(got.is_some(), rule, "{k}");
+            let Some(plane) = got else {
+                declined += 1;
+                continue;
+            };
+            answered += 1;
+            // The exact plane through the vertices (unrounded `T`), at pixel centres of the box, against the walked
+            // plane (row `j0` given, stepped by whole rows and columns from the box's left column).
+            let (dx1, dx2) = (v[1] as i128 - v[0] as i128, v[2] as i128 - v[0] as i128);
+            let (hx, hy) = (dx1 * e2.1 - dx2 * e1.1, dx2 * e1.0 - dx1 * e2.0);
+            for j in (ymin >> 8)..=(ymax >> 8) {
+                for i in (xmin >> 8)..=(xmax >> 8) {
+                    let (cx, cy) = (256 * i as i64 + 128, 256 * j as i64 + 128);
+                    let inside = (0..3).all(|m| {
+                        let (a, b) = (p[m], p[(m + 1) % 3]);
+                        (b.x - a.x) as i64 * (cy - a.y as i64)
+                            - (b.y - a.y) as i64 * (cx - a.x as i64)
+                            >= 0
+                    });
+                    if !inside {
+                        continue;
+                    }
+                    let (px, py) = ((cx - p[0].x as i64) as i128, (cy - p[0].y as i64) as i128);
+                    let exact = v[0] as i128 + (hx * px + hy * py) / area as i128;
+                    // Walked modulo 2^64, as the span loops do (exact at a covered pixel, whose `T` fits).
+                    let walked = plane
+                        .at(i as i64 - g.i_ref)
+                        .wrapping_add(plane.sy.wrapping_mul((j - j0) as i64))
+                        as i128;
+                    assert!((walked - exact).abs() <= t_min >> 33, "{k} at ({i}, {j})");
+                }
+            }
+        }
+        std::println!("answered {answered}, declined {declined}");
+        assert!(answered > 1000 && declined > 1000, "{answered} {declined}");
+    }
+
     /// [`shr_u64`] is `floor(v / 2^s)` for every `s`, 0 from 64 on.
     #[test]
     fn shr_u64_is_the_shift_for_any_count() {
