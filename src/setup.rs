@@ -868,7 +868,7 @@ mod tests {
     /// `i128`), and then its plane is within its derivation's total, `2^15 + 510 (|g| 2^-38 + 1) + 1` (below `|g|
     /// 2^-29 + 2^16`), so within `T_min 2^-33` (the exact solve's bound, which it stands in for), of the
     /// exact plane through the vertices at every pixel centre in the triangle. Random triangles under 127 px
-    /// on the snap grid, with `T` from `2^48` to `2^61` and planes from flat to beyond the rule.
+    /// on the snap grid and slivers, with `T` from `2^48` to `2^61` and planes from flat to beyond the rule.
     #[test]
     fn solve_fast_answers_by_its_rule_within_its_bound() {
         let mut rnd = crate::xorshift(0x50F7_FA57_0000_D1CE);
@@ -880,6 +880,13 @@ mod tests {
                 x: x0 + (rnd() % (256 * size as u64)) as i32,
                 y: y0 + (rnd() % (256 * size as u64)) as i32,
             });
+            if k % 4 == 0 {
+                // A sliver: the third vertex a few sub-pixels off the line through the first two (small areas
+                // with long edges, where a step may not fit: `|g| >= 2A 2^38`).
+                let f = (rnd() % 256) as i32;
+                p[2].x = p[0].x + (p[1].x - p[0].x) * f / 256 + 1 + (rnd() % 8) as i32;
+                p[2].y = p[0].y + (p[1].y - p[0].y) * f / 256;
+            }
             let cross = |p: &[Sub; 3]| {
                 (p[1].x - p[0].x) as i64 * (p[2].y - p[0].y) as i64
                     - (p[2].x - p[0].x) as i64 * (p[1].y - p[0].y) as i64
