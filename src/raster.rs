@@ -1124,27 +1124,13 @@ mod tests {
             if s.on_grid {
                 continue;
             }
-            // The exact correction, as a numerator over the area.
-            let [q0, q1, q2] = s.q.map(|q| (q.x as i128, q.y as i128));
-            let (e1, e2) = ((q1.0 - q0.0, q1.1 - q0.1), (q2.0 - q0.0, q2.1 - q0.1));
-            let a = e1.0 * e2.1 - e2.0 * e1.1;
-            if a == 0 {
+            // The exact correction, as a numerator over the area: `|c' - c| |a|` against the bound `T_min 2^-35
+            // |a|`, without dividing (below 2^127).
+            let x = Exact::of(&s);
+            if x.a == 0 {
                 continue;
             }
-            let t = s.t.map(|v| v as i128);
-            let (d1, d2) = (t[1] - t[0], t[2] - t[0]);
-            let (gx, gy) = (d1 * e2.1 - d2 * e1.1, d2 * e1.0 - d1 * e2.0);
-            let t_min = t[0].min(t[1]).min(t[2]);
-            let check = |out: [i64; 3], how: &str| {
-                for j in 0..3 {
-                    let (rx, ry) = snap_rounding(s.p[j], s.q[j], s.dbits, s.dorigin);
-                    // c = num / a; |c' - c| |a| against the bound T_min 2^-35 |a|, without dividing (below 2^127).
-                    let num = gx * rx as i128 + gy * ry as i128;
-                    let err = ((out[j] as i128 - t[j]) * a - num).abs();
-                    let bound = (t_min >> 35) * a.abs();
-                    assert!(err <= bound, "{how} {k} vertex {j}: {err} > {bound}");
-                }
-            };
+            let check = |out: [i64; 3], how: &str| assert!(x.within_bound(out), "{how} {k}");
             let n = t_at_snapped_narrow(&s);
             let w = t_at_snapped_wide(&s);
             if let Narrow::Done(out) = n {
