@@ -196,8 +196,11 @@ fn ceil_scaled(v: f32, s: i32) -> i64 {
     }
 }
 
-/// `round(v 2^s)` for a finite coordinate below `2^(30 - s)`... in magnitude: at most 31 bits, in 32-bit arithmetic
-/// (the mantissa has 24 bits and its shift is below 7 to the left, or to the right with rounding to nearest, ties up).
+/// `round(v 2^s)` for a finite coordinate below `2^(30 - s)` in magnitude: at most 31 bits, in 32-bit arithmetic
+/// (the mantissa shifted left by below 7 bits, or by up to 29 for a subnormal's shorter mantissa, or to the right with
+/// rounding to nearest, ties up). A shift left was cut at 7 bits before: a mesh whose largest coordinate is
+/// subnormal got half or less of its subnormal coordinates (found by `to_31_rounds_to_nearest`'s sweep of every bit
+/// pattern class).
 #[inline]
 fn to_31(v: f32, s: i32) -> i32 {
     let Some((neg, m, e)) = split(v) else {
@@ -205,7 +208,7 @@ fn to_31(v: f32, s: i32) -> i32 {
     };
     let sh = e + s;
     let r = if sh >= 0 {
-        m << sh.min(7)
+        m << sh.min(31) // below 30 within the domain: `31` only keeps an input outside it from panicking
     } else if sh > -32 {
         let k = (-sh) as u32;
         (m >> k) + ((m >> (k - 1)) & 1)
@@ -295,7 +298,8 @@ mod tests {
             if m == 0 {
                 continue;
             }
-            let e = (rnd() % 300) as i32 - 200;
+            // Down to 2^-260: past the smallest subnormal by more than 64 bits of `m` (everything rounds to 0).
+            let e = (rnd() % 360) as i32 - 260;
             let exact = m as f64 * 2f64.powi(e);
             assert_eq!(to_f32(false, m, e), exact as f32, "{m} 2^{e}");
             assert_eq!(to_f32(true, m, e), -(exact as f32), "{m} 2^{e}");
@@ -303,6 +307,13 @@ mod tests {
         // Ties: 2^24 + 1 rounds down to even, 2^24 + 3 up.
         assert_eq!(to_f32(false, (1 << 25) + 1, -1), 16_777_216.0);
         assert_eq!(to_f32(false, (1 << 25) + 3, -1), 16_777_218.0);
+        // `m` of 64 bits all dropped (`2^63 m'` at `2^-213` is `m' 2^-150`, half the smallest subnormal): above half
+        // it rounds up to `2^-149`, half exactly ties to even (0); dropping more than 64 bits gives 0.
+        assert_eq!(to_f32(false, (1 << 63) + 1, -213).to_bits(), 1);
+        assert_eq!(to_f32(false, u64::MAX, -213).to_bits(), 1);
+        assert_eq!(to_f32(false, 1 << 63, -213).to_bits(), 0);
+        assert_eq!(to_f32(true, u64::MAX, -214).to_bits(), 0x8000_0000);
+        assert_eq!(to_f32(false, u64::MAX, -300).to_bits(), 0);
     }
 
     /// `f32_of` equals `to_f32` of the same value (with the fraction as one bit below `m`), and `top32` the top 32
@@ -332,6 +343,72 @@ mod tests {
         }
     }
 
+    /// `ceil_scaled` is `ceil(v 2^s)`, saturated at `i64::MAX` from `2^62` on, over the whole exponent range: exact
+    /// values from the f32's bits in `u128` (a shift up to 127; below `2^-64` of a positive value the ceiling is 1).
+    #[test]
+    fn ceil_scaled_is_the_ceiling() {
+        let exact = |v: f32, s: i32| -> i64 {
+            let b = v.to_bits();
+            let (be, f) = ((b >> 23) as i32, (b & 0x7f_ffff) as u128);
+            let (m, e) = if be == 0 {
+                (f, -149)
+            } else {
+                (f | 1 << 23, be - 150)
+            };
+            let sh = e + s;
+            let c = if m == 0 {
+                0
+            } else if sh >= 0 {
+                if sh > 100 {
+                    u128::MAX
+                } else {
+                    m << sh
+                }
+            } else if sh > -100 {
+                (m + (1u128 << -sh) - 1) >> -sh
+            } else {
+                1
+            };
+            if c >= 1 << 62 {
+                i64::MAX
+            } else {
+                c as i64
+            }
+        };
+        let mut rnd = crate::xorshift(0xCE11_5CA1_ED00_0001);
+        let mut seen = [0u32; 4]; // saturated, shifted left, a shift right with rounding up, below 1 (so 1)
+        for _ in 0..400_000 {
+            // Every positive finite f32 bit pattern class: subnormals, and exponents across the range.
+            let v = f32::from_bits((rnd() as u32) % 0x7f80_0000);
+            let s = (rnd() % 400) as i32 - 200;
+            let got = ceil_scaled(v, s);
+            assert_eq!(got, exact(v, s), "{v:e} 2^{s}");
+            let sh = crate::fixed::split(v).map_or(0, |(_, _, e)| e + s);
+            match () {
+                _ if got == i64::MAX => seen[0] += 1,
+                _ if sh >= 0 => seen[1] += 1,
+                // Below `2^-24` of the shift's unit the ceiling of a positive value is 1 whichever branch takes it.
+                _ if sh > -24 => seen[2] += 1,
+                _ => seen[3] += 1,
+            }
+        }
+        // The boundaries: `2^62` saturates, the largest mantissa just below it does not; a shift of 39 and of 40 to
+        // the right (the branches' seam); a value exactly on the grid is its own ceiling.
+        assert_eq!(ceil_scaled(1.0, 62), i64::MAX);
+        assert_eq!(
+            ceil_scaled(f32::from_bits(0x3fff_ffff), 61),
+            (0xff_ffffi64) << 38
+        );
+        assert_eq!(ceil_scaled(3.0, -1), 2);
+        assert_eq!(ceil_scaled(f32::from_bits(0x3fff_ffff), -1), 1);
+        assert_eq!(ceil_scaled(1.5, -40 + 23), 1);
+        assert_eq!(ceil_scaled(1.5, 1), 3);
+        assert_eq!(ceil_scaled(1.25, 1), 3);
+        assert_eq!(ceil_scaled(0.0, 10), 0);
+        assert_eq!(ceil_scaled(f32::INFINITY, 0), i64::MAX);
+        assert!(seen.iter().all(|&n| n > 1000), "{seen:?}");
+    }
+
     /// `to_31` equals the exact rounding (ties up) of `v 2^s` for coordinates below `2^(30 - s)`.
     #[test]
     fn to_31_rounds_to_nearest() {
@@ -344,6 +421,200 @@ mod tests {
             let want = (exact + 0.5).floor() as i64 * if v < 0.0 { -1 } else { 1 };
             assert_eq!(to_31(v, s) as i64, want, "{v} {s}");
         }
+        // Every f32 bit pattern class, each at scales from its own limit `|v 2^s| < 2^30` down to `2^-70` of it (the
+        // right shifts past 31 bits, which give 0): exact in `u128` from the bits, ties up.
+        let mut rnd = crate::xorshift(0x0BAD_5EED_0000_0002);
+        let mut seen = [0u32; 3]; // shifted left, rounded by a shift right, below one unit
+        for _ in 0..200_000 {
+            let b = (rnd() as u32) & 0x7fff_ffff;
+            let (be, f) = ((b >> 23) as i32, (b & 0x7f_ffff) as u128);
+            if be == 0xff {
+                continue;
+            }
+            let (m, e) = if be == 0 {
+                (f, -149)
+            } else {
+                (f | 1 << 23, be - 150)
+            };
+            if m == 0 {
+                continue;
+            }
+            let top = e + (128 - m.leading_zeros() as i32); // |v| < 2^top
+            let s = 30 - top - (rnd() % 71) as i32;
+            let sh = e + s;
+            let r = if sh >= 0 {
+                m << sh
+            } else if sh > -100 {
+                (m + (1u128 << (-sh - 1))) >> -sh
+            } else {
+                0
+            };
+            seen[if sh >= 0 {
+                0
+            } else if sh > -32 {
+                1
+            } else {
+                2
+            }] += 1;
+            for neg in [false, true] {
+                let v = f32::from_bits(b | u32::from(neg) << 31);
+                let want = if neg { -(r as i64) } else { r as i64 };
+                assert_eq!(to_31(v, s) as i64, want, "{v:e} 2^{s}");
+            }
+        }
+        // The seam of the right shifts: 31 and 32 bits (half a unit rounds up; below it, 0).
+        assert_eq!(to_31(1.0, -1), 1);
+        assert_eq!(to_31(1.5, -1), 1);
+        assert_eq!(to_31(-1.5, 0), -2);
+        assert_eq!(to_31(f32::from_bits(0x3fff_ffff), -31 + 23), 0); // the mantissa shifted 31 bits right
+        assert_eq!(to_31(f32::from_bits(0x3fff_ffff), -32 + 23), 0); // 32 bits: past a u32's shift
+        assert!(seen.iter().all(|&n| n > 1000), "{seen:?}");
+    }
+
+    /// `W = z` and the viewport map of a 320 x 240 screen, for the boundary cases below.
+    fn w_is_z(near: f32, w_scale: f32, pos: &[[f32; 3]]) -> IntTransform {
+        let planes = Planes::new(near, &Viewport::new(0.0, 0.0, 320.0, 240.0)).unwrap();
+        let mut m = Mat4::IDENTITY;
+        m.0[2][3] = w_scale;
+        m.0[3][3] = 0.0;
+        IntTransform::new(&m, &planes, pos).unwrap()
+    }
+
+    /// The near plane is inclusive, as the f32 path's outcode has it (`W - W_near < 0` is outside): a vertex exactly
+    /// at `W_near` is projected, the f32 just below it is marked for clipping. `rhw` outside the f32 range is
+    /// [`Error::WorldTooLarge`], above it (`W_near` subnormal) and below it (`W` past `2^149`), as `project` says.
+    #[test]
+    fn near_plane_and_rhw_range() {
+        let at = [[0.0, 0.0, 0.5]];
+        let it = w_is_z(0.5, 1.0, &at);
+        let p = it
+            .project(&at[0])
+            .unwrap()
+            .expect("exactly at W_near: drawn");
+        assert_eq!((p.x, p.y, p.rhw), (160.0, 120.0, 2.0));
+        let planes = Planes::new(0.5, &Viewport::new(0.0, 0.0, 320.0, 240.0)).unwrap();
+        assert_eq!(planes.outcode(&[0.0, 0.0, 0.5, 0.5]) & 1, 0);
+        let below = [0.0, 0.0, f32::from_bits(0.5f32.to_bits() - 1)];
+        assert_eq!(it.project(&below).unwrap(), None);
+        assert_eq!(planes.outcode(&[0.0, 0.0, below[2], below[2]]) & 1, 1);
+        // rhw = 1 / 2e-39 overflows f32.
+        let tiny = [[0.0, 0.0, 2e-39]];
+        assert_eq!(
+            w_is_z(1e-39, 1.0, &tiny).project(&tiny[0]),
+            Err(Error::WorldTooLarge)
+        );
+        // W = 2^30 1e38, about 2^156: rhw underflows to 0.
+        let far = [[0.0, 0.0, 1e38]];
+        let it = w_is_z(0.5, (1u64 << 30) as f32, &far);
+        assert_eq!(it.project(&far[0]), Err(Error::WorldTooLarge));
+        // 2^100 is still in range (rhw 2^-130, subnormal) and projects to the centre.
+        let big = [[0.0, 0.0, 2f32.powi(100)]];
+        let p = w_is_z(0.5, 1.0, &big).project(&big[0]).unwrap().unwrap();
+        assert_eq!((p.x, p.y), (160.0, 120.0));
+        assert!(
+            (p.rhw as f64 * 2f64.powi(100) - 1.0).abs() < 2f64.powi(-10),
+            "{:e}",
+            p.rhw
+        );
+    }
+
+    /// A mesh whose every coordinate is zero (all at the model's origin): the positions' exponent is then any, and the
+    /// translation alone places them; and one whose largest coordinate is subnormal. Both against the f64 values.
+    #[test]
+    fn origin_and_subnormal_meshes_project() {
+        let planes = Planes::new(0.5, &Viewport::new(0.0, 0.0, 320.0, 240.0)).unwrap();
+        let m = Mat4::translation([0.25, -0.5, 2.0]);
+        let mut m = m;
+        m.0[2][3] = 1.0; // W = z
+        m.0[3][3] = 2.0; // ... + 2
+        let zero = [[0.0f32; 3]];
+        let p = IntTransform::new(&m, &planes, &zero)
+            .unwrap()
+            .project(&zero[0])
+            .unwrap()
+            .unwrap();
+        // x = 160 + 160 (0.25 / 2), y = 120 - 120 (-0.5 / 2), rhw = 1/2: all exact.
+        assert_eq!((p.x, p.y, p.rhw), (180.0, 150.0, 0.5));
+        let sub = [[1e-39f32, -3e-39, 2e-39], [0.0, 0.0, 0.0]];
+        let it = IntTransform::new(&m, &planes, &sub).unwrap();
+        for q in &sub {
+            let p = it.project(q).unwrap().unwrap();
+            // Against the f64 values; the coordinates move x by below 1e-36 px, so x, y, rhw are those of the
+            // origin's to within the bound of `projection_is_within_its_bound` (2^-22.3 M + 2^-23.9 |x|, M <= 640).
+            let w = 2.0 + q[2] as f64;
+            let (x, y) = (
+                160.0 + 160.0 * (0.25 + q[0] as f64) / w,
+                120.0 - 120.0 * (-0.5 + q[1] as f64) / w,
+            );
+            let b = |v: f64| 2f64.powf(-22.3) * 640.0 + 2f64.powf(-23.9) * v;
+            assert!(
+                (p.x as f64 - x).abs() <= b(x) && (p.y as f64 - y).abs() <= b(y),
+                "{p:?}"
+            );
+            assert!((p.rhw as f64 * w - 1.0).abs() <= 2f64.powf(-23.9) + 2f64.powi(-29) * 2.0);
+        }
+        // The integer positions themselves: every coordinate at the positions' exponent, exactly.
+        let pq = sub[0].map(|v| to_31(v, 30 - it.p));
+        for (k, &v) in sub[0].iter().enumerate() {
+            assert_eq!(
+                pq[k] as f64,
+                (v as f64 * 2f64.powi(30 - it.p)).round(),
+                "{v:e}"
+            );
+        }
+    }
+
+    /// Screen `x` and `y` are the product of the top 32 bits of `X'` (or `Y'`) and `W`'s reciprocal, rounded once
+    /// to f32, to nearest and ties to even, with the product's low word as the sticky fraction (the module doc):
+    /// against [`to_f32`] of the whole 64-bit product, over random vertices.
+    #[test]
+    fn screen_coordinates_round_the_whole_product() {
+        let planes = Planes::new(0.5, &Viewport::new(0.0, 0.0, 320.0, 240.0)).unwrap();
+        let mut rnd = crate::xorshift(0x5C8E_E000_0000_0001);
+        let mut unit = move || (rnd() >> 11) as f32 / (1u64 << 53) as f32;
+        let (mut checked, mut ties) = (0, 0);
+        for _ in 0..200 {
+            let (s, c) = crate::projection::sin_cos(unit() * 6.0);
+            let m = Mat4([
+                [c * 1.3, 0.0, -s, -s],
+                [0.0, 1.7, 0.0, 0.0],
+                [s * 1.3, 0.0, c, c],
+                [0.0, 0.0, 4.0, 4.0],
+            ]);
+            let pos: std::vec::Vec<[f32; 3]> = (0..64)
+                .map(|_| [0, 1, 2].map(|_| unit() * 2.0 - 1.0))
+                .collect();
+            let it = IntTransform::new(&m, &planes, &pos).unwrap();
+            for q in &pos {
+                let Some(p) = it.project(q).unwrap() else {
+                    continue;
+                };
+                let pq = q.map(|v| to_31(v, 30 - it.p));
+                let value = |r: &Row| {
+                    r.a.iter()
+                        .zip(pq)
+                        .fold(r.t, |s, (&a, p)| s + a as i64 * p as i64)
+                };
+                let (wm, lw) = top32(value(&it.rows[2]) as u64);
+                let r = fresh61::<Chord>(wm) as u32 as u64;
+                for (row, got) in [(&it.rows[0], p.x), (&it.rows[1], p.y)] {
+                    let v = value(row);
+                    if v == 0 {
+                        continue;
+                    }
+                    let (xm, lx) = top32(v.unsigned_abs());
+                    let prod = xm as u64 * r;
+                    let want = to_f32(v < 0, prod, lw - lx - 29 + row.e - it.rows[2].e - 32);
+                    assert_eq!(got.to_bits(), want.to_bits(), "{q:?}");
+                    // A tie of the top 32 bits that the low word breaks.
+                    let n = (prod >> 32) as u32;
+                    let n = n << n.leading_zeros();
+                    ties += usize::from(n & 0xff == 0x80 && prod as u32 != 0);
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 20_000 && ties > 50, "{checked} {ties}");
     }
 
     /// Projected vertices against f64 arithmetic on the same f32 positions and matrix, for random rotations, scales
