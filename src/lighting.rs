@@ -124,6 +124,195 @@ mod tests {
     use super::*;
     use embedded_graphics_core::pixelcolor::Rgb565;
 
+    /// Every bad input is an error and writes nothing: a non-finite or zero light direction, a non-finite ambient or
+    /// diffuse term ([`Error::NonFinite`]); an index past the positions (the last valid one is `len - 1`) or an
+    /// output shorter than the faces or normals ([`Error::IndexOutOfRange`]). Outputs exactly as long are fine.
+    #[test]
+    fn bad_input_is_an_error_and_writes_nothing() {
+        let good = Light {
+            direction: [0.0, 0.0, 1.0],
+            ambient: 0.25,
+            diffuse: 0.5,
+        };
+        let pos = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let blue = |_| Rgb888::new(0, 0, 200);
+        let bad = [
+            Light {
+                direction: [f32::NAN, 0.0, 1.0],
+                ..good
+            },
+            Light {
+                direction: [0.0, f32::INFINITY, 1.0],
+                ..good
+            },
+            Light {
+                direction: [0.0; 3],
+                ..good
+            },
+            Light {
+                ambient: f32::NAN,
+                ..good
+            },
+            Light {
+                ambient: f32::INFINITY,
+                ..good
+            },
+            Light {
+                diffuse: f32::NAN,
+                ..good
+            },
+            Light {
+                diffuse: f32::NEG_INFINITY,
+                ..good
+            },
+        ];
+        for light in bad {
+            let mut out = [Rgb888::WHITE; 3];
+            let faces = shade_faces(&pos, &[[0, 1, 2]], &Mat4::IDENTITY, &light, blue, &mut out);
+            let verts = shade_vertices(&pos, &Mat4::IDENTITY, &light, blue, &mut out);
+            assert_eq!(
+                (faces, verts),
+                (Err(Error::NonFinite), Err(Error::NonFinite)),
+                "{light:?}"
+            );
+            assert_eq!(out, [Rgb888::WHITE; 3]);
+        }
+        let mut out = [Rgb888::WHITE; 3];
+        for idx in [[0, 1, 3], [3, 0, 1], [0, 9, 2]] {
+            let r = shade_faces(
+                &pos,
+                &[[0, 1, 2], idx],
+                &Mat4::IDENTITY,
+                &good,
+                blue,
+                &mut out,
+            );
+            assert_eq!(r, Err(Error::IndexOutOfRange), "{idx:?}");
+            assert_eq!(out, [Rgb888::WHITE; 3]);
+        }
+        let r = shade_vertices(&pos, &Mat4::IDENTITY, &good, blue, &mut out[..2]);
+        assert_eq!(r, Err(Error::IndexOutOfRange));
+        assert_eq!(out, [Rgb888::WHITE; 3]);
+        // Exactly as long: every face and vertex written (the face towards the light: 0.75 of 200).
+        shade_faces(
+            &pos,
+            &[[0, 1, 2]],
+            &Mat4::IDENTITY,
+            &good,
+            blue,
+            &mut out[..1],
+        )
+        .unwrap();
+        assert_eq!(out[0], Rgb888::new(0, 0, 150));
+        shade_vertices(&pos[..1], &Mat4::IDENTITY, &good, blue, &mut out[1..2]).unwrap();
+        // A zero normal: the ambient term alone (0.25 of 200).
+        assert_eq!(out[1], Rgb888::new(0, 0, 50));
+    }
+
+    /// The intensity in f64 from the same f32 inputs: `clamp(ambient + diffuse max(0, n' . l), 0, 1)` with `n'` the
+    /// unit normal after the model's upper 3x3 (row vectors) and `l` the unit light direction; `ambient` alone for a
+    /// zero normal.
+    fn intensity_f64(model: &Mat4, n: [f64; 3], light: &Light) -> f64 {
+        let unit = |v: [f64; 3]| {
+            let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            (len > 0.0).then(|| v.map(|c| c / len))
+        };
+        let r: [f64; 3] =
+            core::array::from_fn(|c| (0..3).map(|k| n[k] * model.0[k][c] as f64).sum());
+        let l = unit(light.direction.map(|v| v as f64)).unwrap();
+        let i = match unit(r) {
+            Some(u) => {
+                light.ambient as f64
+                    + light.diffuse as f64 * (u[0] * l[0] + u[1] * l[1] + u[2] * l[2]).max(0.0)
+            }
+            None => light.ambient as f64,
+        };
+        i.clamp(0.0, 1.0)
+    }
+
+    /// Flat and Gouraud shading against [`intensity_f64`] for random models (rotations about all three axes with a
+    /// uniform scale from 0.1 to 10), normals, faces, lights and colours, ambient terms from -0.2 to 1.2 (the clamp
+    /// at both ends) and diffuse ones to 1: each channel is `round(c I)`, ties up.
+    ///
+    /// Bound: the f32 intensity is within `2^-16` of the f64 one (under 64 roundings of `2^-24` of unit-sized terms:
+    /// the rotation 5, the normalisation 6 with the square root's two, the dot product 5, the intensity 2; a face's
+    /// cross product 2 amplified by `1 / sin` of its smallest angle, at most 8 for the faces kept here), so `c I`
+    /// moves by at most `255 2^-16 < 0.004`: the channel must equal `round(c I_f64)` wherever that is farther than
+    /// 0.004 from a tie, and be within one of it everywhere.
+    #[test]
+    fn shading_matches_the_f64_intensity() {
+        let mut rnd = crate::xorshift(0x116E_7000_0000_0001);
+        let mut unit = move || (rnd() >> 11) as f32 / (1u64 << 53) as f32;
+        let (mut exact, mut near_tie, mut clamped) = (0u32, 0u32, [0u32; 2]);
+        let mut check = |got: Rgb888, base: Rgb888, i: f64| {
+            for (g, c) in [
+                (got.r(), base.r()),
+                (got.g(), base.g()),
+                (got.b(), base.b()),
+            ] {
+                let v = c as f64 * i;
+                let want = (v + 0.5).floor();
+                if ((v + 0.5).fract() - 0.5).abs() < 0.5 - 0.004 {
+                    assert_eq!(g as f64, want, "{c} x {i}");
+                    exact += 1;
+                } else {
+                    assert!((g as f64 - v).abs() <= 1.0, "{c} x {i}");
+                    near_tie += 1;
+                }
+            }
+        };
+        for _ in 0..2000 {
+            let sc = 0.1 + unit() * 9.9;
+            let model = Mat4::rotation_x(unit() * 6.3)
+                * Mat4::rotation_y(unit() * 6.3)
+                * Mat4::rotation_z(unit() * 6.3)
+                * Mat4::scale([sc; 3]);
+            let light = Light {
+                direction: [0, 1, 2].map(|_| unit() * 2.0 - 1.0),
+                ambient: unit() * 1.4 - 0.2,
+                diffuse: unit(),
+            };
+            let mut v3 = || [0, 1, 2].map(|_| unit() * 2.0 - 1.0);
+            let pos = [v3(), v3(), v3()];
+            let normal = v3();
+            let base = Rgb888::new((unit() * 255.0) as u8, (unit() * 255.0) as u8, 255);
+            // Gouraud: the vertex normal as given.
+            let mut out = [Rgb888::BLACK; 1];
+            shade_vertices(&[normal], &model, &light, |_| base, &mut out).unwrap();
+            let i = intensity_f64(&model, normal.map(|v| v as f64), &light);
+            check(out[0], base, i);
+            clamped[0] += u32::from(i == 0.0);
+            clamped[1] += u32::from(i == 1.0);
+            // Flat: the face's geometric normal, for faces whose smallest angle's sine is at least 1/8.
+            let d = |a: [f32; 3], b: [f32; 3]| [0, 1, 2].map(|k| b[k] as f64 - a[k] as f64);
+            let cross = |a: [f64; 3], b: [f64; 3]| {
+                [
+                    a[1] * b[2] - a[2] * b[1],
+                    a[2] * b[0] - a[0] * b[2],
+                    a[0] * b[1] - a[1] * b[0],
+                ]
+            };
+            let len = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            let n = cross(d(pos[0], pos[1]), d(pos[0], pos[2]));
+            let sin_min = [0, 1, 2]
+                .map(|k| {
+                    let (a, b, c) = (pos[k], pos[(k + 1) % 3], pos[(k + 2) % 3]);
+                    len(n) / (len(d(a, b)) * len(d(a, c)))
+                })
+                .into_iter()
+                .fold(1.0, f64::min);
+            if sin_min < 0.125 {
+                continue;
+            }
+            shade_faces(&pos, &[[0, 1, 2]], &model, &light, |_| base, &mut out).unwrap();
+            check(out[0], base, intensity_f64(&model, n, &light));
+        }
+        assert!(
+            exact > 10_000 && clamped.iter().all(|&n| n > 50),
+            "{exact} {near_tie} {clamped:?}"
+        );
+    }
+
     /// A face towards the light gets `ambient + diffuse`, one at 60 degrees `ambient + diffuse / 2`, one facing away
     /// only the ambient term; each channel `round(c * I)` of its 8-bit value (Rgb888 of the Rgb565 colour, then back).
     #[test]
