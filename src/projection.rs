@@ -508,6 +508,205 @@ mod tests {
         assert_eq!(c.render_state().unwrap().cull, crate::Cull::Cw);
     }
 
+    /// The rotations move every point as their docs write it, for random angles and points, against f64 with the
+    /// angle's `sin` and `cos` (within [`sin_cos`]'s 4e-7, and the f32 products' and sums' roundings: 2e-6 at the
+    /// points' magnitude, below 2).
+    #[test]
+    fn rotations_move_points_as_documented() {
+        let mut rnd = crate::xorshift(0x0707_A7E0_0000_0001);
+        let mut unit = move || (rnd() >> 11) as f64 / (1u64 << 53) as f64;
+        for _ in 0..2000 {
+            let a = (unit() * 20.0 - 10.0) as f32;
+            let (s, c) = ((a as f64).sin(), (a as f64).cos());
+            let p = [0, 1, 2].map(|_| (unit() * 4.0 - 2.0) as f32);
+            let (x, y, z) = (p[0] as f64, p[1] as f64, p[2] as f64);
+            let cases = [
+                (Mat4::rotation_x(a), [x, y * c - z * s, y * s + z * c]),
+                (Mat4::rotation_y(a), [x * c + z * s, y, -x * s + z * c]),
+                (Mat4::rotation_z(a), [x * c - y * s, x * s + y * c, z]),
+            ];
+            for (m, want) in cases {
+                let got = m.transform([p[0], p[1], p[2], 1.0]);
+                for k in 0..3 {
+                    assert!(
+                        (got[k] as f64 - want[k]).abs() < 2e-6,
+                        "{a} {p:?}: {got:?} {want:?}"
+                    );
+                }
+                assert_eq!(got[3], 1.0);
+            }
+        }
+    }
+
+    /// `look_at` for random eyes, targets and up directions: its rows' `r`, `u`, `f` (the eye's right, up and
+    /// forward in world space) are orthonormal within 1e-6, `f` along `target - eye`, `r = f x up` normalised (right
+    /// of the view in a right-handed world), `u` in the plane of `up` and `f` on `up`'s side; the eye maps to the
+    /// origin, the target to `(0, 0, |target - eye|)`, and a step right of the eye (along `r`) to `x > 0`.
+    #[test]
+    fn look_at_is_an_orthonormal_right_handed_view() {
+        let mut rnd = crate::xorshift(0x1007_A700_0000_0001);
+        let mut unit = move || (rnd() >> 11) as f32 / (1u64 << 53) as f32;
+        let mut v3 = move |s: f32| [0, 1, 2].map(|_| (unit() * 2.0 - 1.0) * s);
+        let f64s = |v: [f32; 3]| v.map(|c| c as f64);
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let mut checked = 0;
+        for _ in 0..2000 {
+            let (eye, target, up) = (v3(10.0), v3(10.0), v3(1.0));
+            let d = [0, 1, 2].map(|k| target[k] as f64 - eye[k] as f64);
+            let (dn, un) = (dot(d, d).sqrt(), dot(f64s(up), f64s(up)).sqrt());
+            // Well away from the refusals (eye at the target, up along the view).
+            if dn < 0.1
+                || cross(d, f64s(up)).iter().map(|c| c * c).sum::<f64>().sqrt() < 0.1 * dn * un
+            {
+                continue;
+            }
+            let m = Mat4::look_at(eye, target, up).unwrap();
+            let col = |c: usize| [0, 1, 2].map(|r| m.0[r][c] as f64);
+            let (r, u, f) = (col(0), col(1), col(2));
+            for (a, b, want) in [
+                (r, r, 1.0),
+                (u, u, 1.0),
+                (f, f, 1.0),
+                (r, u, 0.0),
+                (r, f, 0.0),
+                (u, f, 0.0),
+            ] {
+                assert!((dot(a, b) - want).abs() < 1e-6, "{eye:?} {target:?} {up:?}");
+            }
+            assert!((dot(f, d) / dn - 1.0).abs() < 1e-6);
+            let fu = cross(f, f64s(up));
+            let fu_n = dot(fu, fu).sqrt();
+            assert!(
+                (dot(r, fu) / fu_n - 1.0).abs() < 1e-6,
+                "right = forward x up"
+            );
+            assert!(dot(u, f64s(up)) > 0.0 && dot(cross(r, u), f) < -1.0 + 1e-6);
+            let e = m.transform([eye[0], eye[1], eye[2], 1.0]);
+            let t = m.transform([target[0], target[1], target[2], 1.0]);
+            assert!(e[..3].iter().all(|v| v.abs() < 1e-5), "{e:?}");
+            assert!(t[0].abs() < 1e-5 && t[1].abs() < 1e-5 && (t[2] as f64 - dn).abs() < 1e-5 * dn);
+            let right = [0, 1, 2].map(|k| eye[k] + r[k] as f32);
+            assert!(m.transform([right[0], right[1], right[2], 1.0])[0] > 0.5);
+            checked += 1;
+        }
+        assert!(checked > 1000, "{checked}");
+    }
+
+    /// `perspective`'s field of view is open at both ends, `(0, pi)`, and `aspect` must be positive.
+    #[test]
+    fn perspective_refuses_its_limits() {
+        let pi = core::f32::consts::PI;
+        for (fov, aspect) in [
+            (0.0, 1.0),
+            (-0.5, 1.0),
+            (pi, 1.0),
+            (4.0, 1.0),
+            (1.0, 0.0),
+            (1.0, -1.0),
+        ] {
+            assert_eq!(
+                perspective(fov, aspect, 1.0, 10.0),
+                Err(Error::InvalidCamera),
+                "{fov} {aspect}"
+            );
+        }
+        let below_pi = f32::from_bits(pi.to_bits() - 1);
+        for (fov, aspect) in [
+            (f32::MIN_POSITIVE, 1.0),
+            (1e-3, 1.0),
+            (below_pi, 1.0),
+            (1.0, 1e-30),
+        ] {
+            let p = perspective(fov, aspect, 1.0, 10.0).unwrap();
+            assert!(
+                p.matrix.0.iter().flatten().all(|v| v.is_finite()),
+                "{fov} {aspect}"
+            );
+        }
+    }
+
+    /// `D3DUtil_SetProjectionMatrix`'s five entries as its doc writes them, against f64 with the half angle's `sin`
+    /// and `cos` (within [`sin_cos`]'s 4e-7 and a few f32 roundings: 2e-6 relative); its refusals: any non-finite
+    /// argument or a field of view outside `(0, pi)` ([`Error::NonFinite`]), `far - near` below 0.01 (0.01 itself
+    /// is accepted, as the seed's `< 0.01` test has it).
+    #[test]
+    fn d3dutil_entries_and_refusals() {
+        let close = |a: f32, b: f64| (a as f64 - b).abs() <= 2e-6 * b.abs();
+        for (fov, aspect, n, f) in [
+            (1.0f32, 0.75f32, 1.0f32, 100.0f32),
+            (2.5, 1.3, 0.5, 7.0),
+            (0.2, 0.6, 3.0, 4.0),
+        ] {
+            let m = d3dutil_set_projection_matrix(fov, aspect, n, f).unwrap();
+            let (sn, cs) = ((fov as f64 / 2.0).sin(), (fov as f64 / 2.0).cos());
+            let q = f as f64 * sn / (f as f64 - n as f64);
+            assert!(close(m.at(1, 1), cs * aspect as f64), "{m:?}");
+            assert!(close(m.at(2, 2), cs) && close(m.at(3, 3), q) && close(m.at(3, 4), sn));
+            assert!(close(m.at(4, 3), -q * n as f64));
+            let zero = [
+                (1, 2),
+                (1, 3),
+                (1, 4),
+                (2, 1),
+                (2, 3),
+                (2, 4),
+                (3, 1),
+                (3, 2),
+                (4, 1),
+                (4, 2),
+                (4, 4),
+            ];
+            assert!(zero.iter().all(|&(r, c)| m.at(r, c) == 0.0));
+        }
+        let ok = (1.0, 1.0, 1.0, 10.0);
+        for k in 0..4 {
+            for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+                let mut a = [ok.0, ok.1, ok.2, ok.3];
+                a[k] = bad;
+                assert_eq!(
+                    d3dutil_set_projection_matrix(a[0], a[1], a[2], a[3]),
+                    Err(Error::NonFinite),
+                    "{a:?}"
+                );
+            }
+        }
+        let pi = core::f32::consts::PI;
+        for fov in [0.0, -1.0, pi, 3.5] {
+            assert_eq!(
+                d3dutil_set_projection_matrix(fov, 1.0, 1.0, 10.0),
+                Err(Error::NonFinite),
+                "{fov}"
+            );
+        }
+        assert!(
+            d3dutil_set_projection_matrix(f32::from_bits(pi.to_bits() - 1), 1.0, 1.0, 10.0).is_ok()
+        );
+        assert!(d3dutil_set_projection_matrix(1.0, 1.0, 0.0, 0.01).is_ok());
+        let just_below = f32::from_bits(0.01f32.to_bits() - 1);
+        assert_eq!(
+            d3dutil_set_projection_matrix(1.0, 1.0, 0.0, just_below),
+            Err(Error::InvalidDepthRange)
+        );
+    }
+
+    /// `w_planes` refuses a matrix for which either plane is not finite, the other being finite: `_33 = 0` (the near
+    /// plane infinite) and `_33 = _34` (the far plane infinite).
+    #[test]
+    fn w_planes_refuse_either_plane_infinite() {
+        let mut m = Mat4::IDENTITY;
+        (m.0[2][2], m.0[2][3], m.0[3][2], m.0[3][3]) = (0.0, 1.0, 1.0, 0.0); // near -inf, far 1
+        assert_eq!(w_planes(&m), Err(Error::NonFinite));
+        (m.0[2][2], m.0[2][3], m.0[3][2], m.0[3][3]) = (1.0, 1.0, -1.0, 0.0); // near 1, far inf
+        assert_eq!(w_planes(&m), Err(Error::NonFinite));
+    }
+
     /// `sqrt` within two f32 roundings of the true root.
     #[test]
     fn newton_sqrt() {
