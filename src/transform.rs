@@ -344,7 +344,7 @@ mod tests {
     }
 
     /// `ceil_scaled` is `ceil(v 2^s)`, saturated at `i64::MAX` from `2^62` on, over the whole exponent range: exact
-    /// values from the f32's bits in `u128` (a shift up to 127; below `2^-64` of a positive value the ceiling is 1).
+    /// values from the f32's bits in `u128` (shifts up to 100 bits; a positive value below `2^-76` has the ceiling 1).
     #[test]
     fn ceil_scaled_is_the_ceiling() {
         let exact = |v: f32, s: i32| -> i64 {
