@@ -343,18 +343,28 @@ mod tests {
         }
     }
 
+    /// A finite f32's bits as `(mantissa, exponent)`, `|v| = m 2^e`, decoded here (not by `split`), for the exact
+    /// references below.
+    fn bits_of(b: u32) -> (u128, i32) {
+        let (be, f) = (((b >> 23) & 0xff) as i32, (b & 0x7f_ffff) as u128);
+        if be == 0 {
+            (f, -149)
+        } else {
+            (f | 1 << 23, be - 150)
+        }
+    }
+
+    /// `W_near` and the viewport map of a 320 x 240 screen.
+    fn planes(near: f32) -> Planes {
+        Planes::new(near, &Viewport::new(0.0, 0.0, 320.0, 240.0)).unwrap()
+    }
+
     /// `ceil_scaled` is `ceil(v 2^s)`, saturated at `i64::MAX` from `2^62` on, over the whole exponent range: exact
     /// values from the f32's bits in `u128` (shifts up to 100 bits; a positive value below `2^-76` has the ceiling 1).
     #[test]
     fn ceil_scaled_is_the_ceiling() {
         let exact = |v: f32, s: i32| -> i64 {
-            let b = v.to_bits();
-            let (be, f) = ((b >> 23) as i32, (b & 0x7f_ffff) as u128);
-            let (m, e) = if be == 0 {
-                (f, -149)
-            } else {
-                (f | 1 << 23, be - 150)
-            };
+            let (m, e) = bits_of(v.to_bits());
             let sh = e + s;
             let c = if m == 0 {
                 0
@@ -427,15 +437,10 @@ mod tests {
         let mut seen = [0u32; 3]; // shifted left, rounded by a shift right, below one unit
         for _ in 0..200_000 {
             let b = (rnd() as u32) & 0x7fff_ffff;
-            let (be, f) = ((b >> 23) as i32, (b & 0x7f_ffff) as u128);
-            if be == 0xff {
+            if b >> 23 == 0xff {
                 continue;
             }
-            let (m, e) = if be == 0 {
-                (f, -149)
-            } else {
-                (f | 1 << 23, be - 150)
-            };
+            let (m, e) = bits_of(b);
             if m == 0 {
                 continue;
             }
@@ -473,7 +478,7 @@ mod tests {
 
     /// `W = z` and the viewport map of a 320 x 240 screen, for the boundary cases below.
     fn w_is_z(near: f32, w_scale: f32, pos: &[[f32; 3]]) -> IntTransform {
-        let planes = Planes::new(near, &Viewport::new(0.0, 0.0, 320.0, 240.0)).unwrap();
+        let planes = planes(near);
         let mut m = Mat4::IDENTITY;
         m.0[2][3] = w_scale;
         m.0[3][3] = 0.0;
@@ -492,7 +497,7 @@ mod tests {
             .unwrap()
             .expect("exactly at W_near: drawn");
         assert_eq!((p.x, p.y, p.rhw), (160.0, 120.0, 2.0));
-        let planes = Planes::new(0.5, &Viewport::new(0.0, 0.0, 320.0, 240.0)).unwrap();
+        let planes = planes(0.5);
         assert_eq!(planes.outcode(&[0.0, 0.0, 0.5, 0.5]) & 1, 0);
         let below = [0.0, 0.0, f32::from_bits(0.5f32.to_bits() - 1)];
         assert_eq!(it.project(&below).unwrap(), None);
@@ -522,7 +527,7 @@ mod tests {
     /// translation alone places them; and one whose largest coordinate is subnormal. Both against the f64 values.
     #[test]
     fn origin_and_subnormal_meshes_project() {
-        let planes = Planes::new(0.5, &Viewport::new(0.0, 0.0, 320.0, 240.0)).unwrap();
+        let planes = planes(0.5);
         let m = Mat4::translation([0.25, -0.5, 2.0]);
         let mut m = m;
         m.0[2][3] = 1.0; // W = z
@@ -569,7 +574,7 @@ mod tests {
     /// against [`to_f32`] of the whole 64-bit product, over random vertices.
     #[test]
     fn screen_coordinates_round_the_whole_product() {
-        let planes = Planes::new(0.5, &Viewport::new(0.0, 0.0, 320.0, 240.0)).unwrap();
+        let planes = planes(0.5);
         let mut rnd = crate::xorshift(0x5C8E_E000_0000_0001);
         let mut unit = move || (rnd() >> 11) as f32 / (1u64 << 53) as f32;
         let (mut checked, mut ties) = (0, 0);
