@@ -740,8 +740,31 @@ pub(crate) fn slope_bias(state: &RenderState, p: &[Sub; 3], c: [f32; 3], max: f3
     if !off.is_finite() {
         return 0;
     }
-    let r = if off >= 0.0 { off + 0.5 } else { off - 0.5 };
-    r.clamp(-max, max) as i32
+    round_half_away(off).clamp(-max, max) as i32
+}
+
+/// A finite `v` rounded to the nearest integer, ties away from zero. (`f32::round` is not in `core`, and `micromath`'s
+/// `round`, like the sum `v + 0.5` truncated, is not this: the sum rounds in f32, so `0.5 - 2^-25` becomes 1 and
+/// `2^23 + 1` becomes `2^23 + 2`.) Below `2^23`, `t = floor(|v|)` is exact through `u32`, and so are `|v| - t` (the
+/// fraction of `|v|`) and `t + 1`; from `2^23` on every f32 is an integer.
+#[cfg(feature = "bias")]
+fn round_half_away(v: f32) -> f32 {
+    let a = v.abs();
+    let r = if a >= 8_388_608.0 {
+        a
+    } else {
+        let t = a as u32 as f32;
+        if a - t >= 0.5 {
+            t + 1.0
+        } else {
+            t
+        }
+    };
+    if v < 0.0 {
+        -r
+    } else {
+        r
+    }
 }
 
 #[cfg(test)]
@@ -987,6 +1010,51 @@ mod tests {
                 assert_eq!(shr_u64(v, s), v.checked_shr(s).unwrap_or(0), "{v} >> {s}");
             }
             assert_eq!(shr_u64(u64::MAX, s), u64::MAX.checked_shr(s).unwrap_or(0));
+        }
+    }
+
+    /// [`slope_bias`] of a triangle whose vertex codes are equal (slope 0, so the offset is the constant bias alone)
+    /// is that constant rounded to the nearest code, ties away from zero, then clamped to `[-max, max]`: at the f32
+    /// values where adding 0.5 rounds the sum (`0.5 - 2^-25`; odd integers from `2^23`), at ties, and at random
+    /// constants against the f64 rounding (exact: an f32 and its floor are exact in f64).
+    #[cfg(feature = "bias")]
+    #[test]
+    fn slope_bias_rounds_to_nearest_ties_away() {
+        let p = [(0, 0), (2560, 0), (0, 2560)].map(|(x, y)| Sub { x, y });
+        let mut st = RenderState::new(1.0, 100.0).unwrap();
+        st.slope_scale_depth_bias = 3.0;
+        let mut bias = |c: f32, max: f32| {
+            st.depth_bias = c;
+            slope_bias(&st, &p, [1000.0; 3], max)
+        };
+        let below_half = 0.5 - f32::EPSILON / 4.0; // 0.5 - 2^-25, the largest f32 below 0.5
+        let max24 = 16_777_215.0; // a 24-bit format's largest code
+        for (c, max, want) in [
+            (below_half, 65535.0, 0),
+            (-below_half, 65535.0, 0),
+            (0.5, 65535.0, 1),
+            (-0.5, 65535.0, -1),
+            (1.5, 65535.0, 2),
+            (2.5, 65535.0, 3),
+            (-2.5, 65535.0, -3),
+            (8_388_609.0, max24, 8_388_609),
+            (-8_388_609.0, max24, -8_388_609),
+            (8_388_607.5, max24, 8_388_608),
+            (70_000.0, 65535.0, 65535),
+            (-70_000.4, 65535.0, -65535),
+        ] {
+            assert_eq!(bias(c, max), want, "constant {c}");
+        }
+        let mut rnd = crate::xorshift(0xB1A5_0FF5_E7ED_6E5D);
+        for k in 0..100_000 {
+            // Magnitudes from 2^-8 to 2^25, either sign.
+            let mag = (1u64 << (k % 33)) as f64 / 256.0;
+            let c = ((rnd() % 1_000_000) as f64 / 1e6 * mag) as f32
+                * if rnd() & 1 == 0 { 1.0 } else { -1.0 };
+            let a = (c as f64).abs();
+            let r = (a.floor() + if a - a.floor() >= 0.5 { 1.0 } else { 0.0 }).min(max24 as f64);
+            let want = (if c < 0.0 { -r } else { r }) as i32;
+            assert_eq!(bias(c, max24), want, "constant {c}");
         }
     }
 }
