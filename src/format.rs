@@ -86,14 +86,20 @@ pub trait DepthFormat {
     }
 }
 
-/// `round(x)` for `x >= 0`, clamped to `[0, max]` (no `f64::round` in `core`).
+/// `round(x)` for `x >= 0`, ties up, clamped to `[0, max]` (no `f64::round` in `core`). Below `max < 2^32`,
+/// `floor(x)` and the fraction `x - floor(x)` are exact; `x + 0.5` is not (it rounds `0.5 - 2^-54` up to 1).
 fn unorm(x: f64, max: u32) -> u32 {
     if x.is_nan() || x <= 0.0 {
         0
     } else if x >= max as f64 {
         max
     } else {
-        (x + 0.5) as u32
+        let t = x as u32;
+        if x - t as f64 >= 0.5 {
+            t + 1
+        } else {
+            t
+        }
     }
 }
 
@@ -388,6 +394,63 @@ mod tests {
         round_trip::<Z32F>();
         round_trip::<RZ32F>();
         round_trip::<LZ16>();
+    }
+
+    /// `unorm` rounds to nearest, ties up, and clamps: at the ties, at the largest f64 below one half (where
+    /// `x + 0.5` itself rounds up to 1), next to `max`, and outside `[0, max]` and at NaN.
+    #[test]
+    fn unorm_rounds_to_nearest() {
+        let below_half = 0.5 - f64::EPSILON / 4.0; // 0.5 - 2^-54
+        for (x, max, want) in [
+            (below_half, 10, 0),
+            (0.5, 10, 1),
+            (1.5, 10, 2),
+            (2.5, 10, 3),
+            (2.499_999_999, 10, 2),
+            (9.5, 10, 10),
+            (9.499_999, 10, 9),
+            (10.0, 10, 10),
+            (1e300, 10, 10),
+            (-0.4, 10, 0),
+            (f64::NAN, 10, 0),
+            (4_294_967_294.5, u32::MAX, u32::MAX),
+            (4_294_967_293.25, u32::MAX, 4_294_967_293),
+        ] {
+            assert_eq!(unorm(x, max), want, "{x}");
+        }
+    }
+
+    /// The step at the last code is the distance to the code below it, and elsewhere to the code above. The last
+    /// code is the far plane's for W16 and the Z formats and the near plane's for reversed Z; the float W formats put
+    /// the far plane below their largest value (W16F's is 256, code `0xF000`), so no depth in range reaches it.
+    #[test]
+    fn step_at_the_last_code_looks_down() {
+        fn check<F: DepthFormat>(reaches_last: bool) {
+            let (n, f) = (10.0, 1000.0);
+            let at = |c: u32| F::decode(c, n, f);
+            let up = |c: u32| (at(c + 1) - at(c)).abs();
+            for d in [if F::NAME == "RZ32F" { n } else { f }, (n * f).sqrt()] {
+                let c = F::encode(d, n, f);
+                let want = if c == F::MAX_CODE {
+                    (at(c) - at(c - 1)).abs()
+                } else {
+                    up(c)
+                };
+                assert_eq!(F::step(d, n, f), want, "{} {d}", F::NAME);
+            }
+            let last = F::encode(if F::NAME == "RZ32F" { n } else { f }, n, f);
+            assert_eq!(last == F::MAX_CODE, reaches_last, "{}", F::NAME);
+        }
+        check::<W16>(true);
+        check::<W16F>(false);
+        check::<W24F>(false);
+        check::<W24FScaled>(false);
+        check::<W32F>(false);
+        check::<Z16>(true);
+        check::<Z24>(true);
+        check::<Z32F>(true);
+        check::<RZ32F>(true);
+        check::<LZ16>(true);
     }
 
     /// W16's step is `W_far / 65535` everywhere (the precision notes in ARCHITECTURE.md: unorm W, constant step).
