@@ -1013,6 +1013,140 @@ mod tests {
         }
     }
 
+    /// [`Plane::solve_ref`] is the plane through the positions `dq` with each of its three terms rounded once (ties
+    /// away from zero), formed here in `i128` from the definitions: the value at the reference pixel's centre,
+    /// `v_0 + round((gx rx + gy ry) / 2A)`, and the steps `round(g 2^dbits / 2A)` (kept modulo 2^64, as the walk
+    /// does). On grids of 8 to 30 fraction bits, both orientations, with the reference pixel's offset from vertex 0
+    /// inside an `i32` (the limb products) and beyond it (the general product; the drawing paths' grids keep them
+    /// from needing it, so only this test reaches it).
+    #[test]
+    fn solve_ref_is_the_plane_rounded_once() {
+        let round = |n: i128, d: i128| (2 * n.abs() + d) / (2 * d) * n.signum();
+        let mut rnd = crate::xorshift(0x50_1BE0_EF00_0D1E);
+        let (mut narrow, mut wide) = (0u32, 0u32);
+        for k in 0..20_000u64 {
+            let dbits = 8 + (rnd() % 23) as u32;
+            // Positions below 2^30 units; the triangle up to 127 px (fewer on the finest grids).
+            let size = 1 + rnd() % 127u64.min(1 << (30 - dbits));
+            let dq = [0; 3].map(|_| Sub {
+                x: (rnd() % (size << dbits)) as i32,
+                y: (rnd() % (size << dbits)) as i32,
+            });
+            let (e1, e2) = (
+                ((dq[1].x - dq[0].x) as i128, (dq[1].y - dq[0].y) as i128),
+                ((dq[2].x - dq[0].x) as i128, (dq[2].y - dq[0].y) as i128),
+            );
+            let darea = e1.0 * e2.1 - e2.0 * e1.1;
+            if darea == 0 {
+                continue;
+            }
+            // `T` below 2^61, spread so that the numerator stays below 2^126 at the widest offsets.
+            let top = 1i64 << (30 + rnd() % 31);
+            let v = [0; 3].map(|_| top - (rnd() % (top as u64 >> (rnd() % 30)).max(1)) as i64);
+            // The reference pixel up to 2^(30 - dbits) px from the grid's origin (within 2^31 units) or, every
+            // other triangle, up to 2^(33 - dbits) px (mostly beyond).
+            let far = 1u64 << (if k % 2 == 0 { 30 } else { 33 } - dbits);
+            let (i_off, j_off) = ((rnd() % far) as i64, (rnd() % far) as i32);
+            let dorigin = ((rnd() % 100) as i32, (rnd() % 100) as i32);
+            let g = Geom {
+                p: dq,
+                area: darea.abs() as i64,
+                dq,
+                darea: darea as i64,
+                dbits,
+                dorigin,
+                i_ref: dorigin.0 as i64 + i_off,
+                j_ref: dorigin.1 + j_off,
+                j0: dorigin.1 + j_off,
+            };
+            let (d1, d2) = (v[1] as i128 - v[0] as i128, v[2] as i128 - v[0] as i128);
+            let (mut gx, mut gy) = (d1 * e2.1 - d2 * e1.1, d2 * e1.0 - d1 * e2.0);
+            let mut a = darea;
+            if a < 0 {
+                (gx, gy, a) = (-gx, -gy, -a);
+            }
+            let u = 1i128 << dbits;
+            let (rx, ry) = (
+                u * i_off as i128 + u / 2 - dq[0].x as i128,
+                u * j_off as i128 + u / 2 - dq[0].y as i128,
+            );
+            if i32::try_from(rx).is_ok() && i32::try_from(ry).is_ok() {
+                narrow += 1;
+            } else {
+                wide += 1;
+            }
+            let got = Plane::solve_ref(v, &g);
+            let want = Plane {
+                row: (v[0] as i128 + round(gx * rx + gy * ry, a)) as i64,
+                sx: round(gx << dbits, a) as i64,
+                sy: round(gy << dbits, a) as i64,
+            };
+            assert_eq!(got, want, "{k}: dbits {dbits}, offsets ({rx}, {ry})");
+        }
+        assert!(narrow > 5000 && wide > 5000, "{narrow} {wide}");
+    }
+
+    /// [`slope_bias`] is `m s + c` rounded to the nearest code and clamped (`m` the larger of the plane's
+    /// `|d code / dx|` and `|d code / dy|` in codes a pixel, `s` the slope scale, `c` the constant bias), against
+    /// `m` formed here in f64 from the definitions. Random triangles up to 16 px anywhere in the guard band, with
+    /// integer codes below 2^11: every f32 product and difference before the division is then exact (below 2^24),
+    /// so the f32 path rounds three times, the quotient and the product (`2^-24` of `|m s|` each) and the sum
+    /// (`2^-24` of the result; half an ulp each, and the `+ 1` of `err` below covers the second-order terms, under
+    /// `2^-48 |m s|`), and each triangle is checked wherever the f64 value is farther than that from a tie.
+    #[cfg(feature = "bias")]
+    #[test]
+    fn slope_bias_is_the_largest_slope_times_scale_plus_constant() {
+        let mut rnd = crate::xorshift(0x510B_EB1A_5000_0001);
+        let mut st = RenderState::new(1.0, 100.0).unwrap();
+        let (mut checked, mut clamped) = (0u32, 0u32);
+        for k in 0..100_000u64 {
+            let o = [0; 2].map(|_| (rnd() % (1 << 21)) as i32 - (1 << 20));
+            let p = [0; 3].map(|_| Sub {
+                x: o[0] + (rnd() % 4096) as i32,
+                y: o[1] + (rnd() % 4096) as i32,
+            });
+            let c = [0; 3].map(|_| (rnd() % 2048) as f32);
+            st.slope_scale_depth_bias = (rnd() % 2001) as f32 / 250.0 - 4.0;
+            st.depth_bias = (rnd() % 20001) as f32 / 100.0 - 100.0;
+            let d = |a: i32, b: i32| (b - a) as f64;
+            let (dx1, dy1, dx2, dy2) = (
+                d(p[0].x, p[1].x),
+                d(p[0].y, p[1].y),
+                d(p[0].x, p[2].x),
+                d(p[0].y, p[2].y),
+            );
+            let area = dx1 * dy2 - dx2 * dy1;
+            if area == 0.0 {
+                continue;
+            }
+            let (c1, c2) = ((c[1] - c[0]) as f64, (c[2] - c[0]) as f64);
+            let gx = (c1 * dy2 - c2 * dy1) / area * 256.0;
+            let gy = (c2 * dx1 - c1 * dx2) / area * 256.0;
+            let ms = gx.abs().max(gy.abs()) * st.slope_scale_depth_bias as f64;
+            let off = ms + st.depth_bias as f64;
+            let max = 65535.0;
+            let got = slope_bias(&st, &p, c, max as f32);
+            if off.abs() > max + 1.0 {
+                assert_eq!(got as f64, max * off.signum(), "{k}");
+                clamped += 1;
+                continue;
+            }
+            let err = (2.0 * ms.abs() + off.abs() + 1.0) * f32::EPSILON as f64 / 2.0;
+            let frac = off - off.floor();
+            if (frac - 0.5).abs() <= err {
+                continue;
+            }
+            let r = if frac > 0.5 {
+                off.floor() + 1.0
+            } else {
+                off.floor()
+            };
+            assert_eq!(got as f64, r.clamp(-max, max), "{k}: offset {off}");
+            checked += 1;
+        }
+        assert!(checked > 50_000 && clamped > 100, "{checked} {clamped}");
+    }
+
     /// [`slope_bias`] of a triangle whose vertex codes are equal (slope 0, so the offset is the constant bias alone)
     /// is that constant rounded to the nearest code, ties away from zero, then clamped to `[-max, max]`: at the f32
     /// values where adding 0.5 rounds the sum (`0.5 - 2^-25`; odd integers from `2^23`), at ties, and at random
