@@ -1800,6 +1800,179 @@ mod tests {
         check::<crate::recip::FastDiv>();
     }
 
+    /// A cache handed to a new frame by `with_plane_cache` starts empty: a frame whose first band starts where the
+    /// last frame's last band ended, drawn the same way (so the band would otherwise follow it), draws what it draws
+    /// with a fresh cache, though the two frames' triangles share their indices (W4's frame 0, then the same with
+    /// the world scaled about the eye: the same triangles cross the split at row 128, at other depths; the middle
+    /// row, 120, is a row of vertices that no triangle crosses).
+    #[test]
+    #[cfg(feature = "scenes")]
+    fn a_new_frame_takes_nothing_from_the_last() {
+        use crate::scenes::torus;
+        use embedded_graphics_core::pixelcolor::Rgb565;
+        let (w, h, rows) = (320u16, 240u16, 8u16);
+        let (positions, indices, colors) = (torus::positions(), torus::indices(), torus::colors());
+        let mesh = Mesh {
+            positions: &positions,
+            indices: &indices,
+            colors: Colors::PerFace(&colors),
+        };
+        let cam = torus::camera().unwrap();
+        let mut r = Rasterizer::<Fast>::new(cam.render_state().unwrap());
+        let vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
+        let mut verts = vec![Projected::default(); torus::VERTICES];
+        // Frame 0 with the world scaled by `s` about the eye (0, 0, 3): the same screen positions (to f32 rounding),
+        // every `W` times `s`. Its bands from row `from` to `to` with `cache`: colour and depth.
+        let mut draw = |s: f32, (from, to): (u16, u16), cache: &mut PlaneCache<200>| {
+            let about_eye = Mat4::translation([0.0, 0.0, -3.0])
+                * Mat4::scale([s; 3])
+                * Mat4::translation([0.0, 0.0, 3.0]);
+            let m = cam.model_matrix(&(torus::model(0) * about_eye));
+            let frame = r.transform_mesh(&mesh, &m, &vp, &mut verts).unwrap();
+            let frame = frame.with_plane_cache(cache);
+            let (mut color, mut z) = (
+                vec![0u16; w as usize * h as usize],
+                vec![0u16; w as usize * h as usize],
+            );
+            for y0 in (from..to).step_by(rows as usize) {
+                let at = y0 as usize * w as usize..(y0 + rows) as usize * w as usize;
+                let mut band =
+                    crate::ColorBand::<Rgb565>::band(&mut color[at.clone()], w, y0 as i32, rows)
+                        .unwrap();
+                let mut depth = DepthBuffer::band(&mut z[at], w, y0 as i32, rows).unwrap();
+                depth.clear();
+                r.draw_mesh_frame(&mut band, &mut depth, &frame).unwrap();
+            }
+            (color, z)
+        };
+        let mut cache = PlaneCache::<200>::new();
+        draw(1.0, (0, 128), &mut cache);
+        let reused = draw(1.25, (128, h), &mut cache);
+        let fresh = draw(1.25, (128, h), &mut PlaneCache::new());
+        assert!(reused == fresh);
+        // The same pixels, other depths.
+        let first = draw(1.0, (128, h), &mut PlaneCache::new());
+        assert!(first.1 != fresh.1);
+    }
+
+    /// The cache's ring against a model, a queue with a capacity: a band that follows the previous one (it begins
+    /// where that one ended, with the same tag) finds what that band kept, in triangle order, and drops what it skips;
+    /// any other band, and a reset, empty it; a full ring keeps nothing more. Every kind of value comes back as it was
+    /// kept (the depth-grid values or none, a plane and its fraction bits, a small triangle's constants and shifts),
+    /// a small triangle's shifts beyond the key's bits are not kept, and a triangle is kept only where it reaches
+    /// below the band (`Remembered`'s rule). Rings of 1 to 7 slots, random bands, triangles and values.
+    #[test]
+    fn the_cache_ring_follows_its_model() {
+        use std::collections::VecDeque;
+        let mut rnd = crate::xorshift(0xCAC4_E000_0000_0001);
+        for cap in [1usize, 2, 3, 7] {
+            let state = PlaneCache::<0>::new().state;
+            let slots = vec![Cell::new(Slot { key: 0, t: [0; 6] }); cap];
+            let cache = Cache {
+                state: &state,
+                slots: &slots,
+            };
+            cache.reset();
+            let (mut queue, mut prev) = (VecDeque::<(u32, Remember)>::new(), 0usize);
+            let (mut band_end, mut tag, mut next_k) = (i32::MIN, 0u64, 0u32);
+            for step in 0..40_000 {
+                match rnd() % 10 {
+                    0 | 1 => {
+                        // A band: mostly the next one, drawn the same way.
+                        let y0 = if !rnd().is_multiple_of(4) {
+                            band_end
+                        } else {
+                            (rnd() % 300) as i32
+                        };
+                        let (h, t) = (
+                            1 + (rnd() % 8) as u16,
+                            if rnd().is_multiple_of(8) {
+                                rnd() % 3
+                            } else {
+                                tag
+                            },
+                        );
+                        cache.begin(y0, h, t);
+                        if band_end == y0 && tag == t {
+                            queue.drain(..prev);
+                        } else {
+                            queue.clear();
+                        }
+                        (prev, band_end, tag, next_k) = (queue.len(), y0 + h as i32, t, 0);
+                    }
+                    2 if rnd().is_multiple_of(8) => {
+                        cache.reset();
+                        (queue, prev, band_end) = (VecDeque::new(), 0, i32::MIN);
+                    }
+                    // Keeps come within a band.
+                    _ if band_end == i32::MIN => {}
+                    2..=5 => {
+                        // The band's next triangle, at or after the last one.
+                        let k = (next_k + (rnd() % 3) as u32).min(INDEX);
+                        next_k = k + 1;
+                        let mut want = None;
+                        while prev > 0 && queue[0].0 <= k {
+                            let (key, r) = queue.pop_front().unwrap();
+                            prev -= 1;
+                            if key == k {
+                                want = Some(r);
+                                break;
+                            }
+                        }
+                        assert_eq!(cache.take(k), want, "cap {cap}, step {step}");
+                    }
+                    _ => {
+                        let k = next_k.saturating_sub(1);
+                        let v = [0; 3].map(|_| rnd() as i64);
+                        let r = match rnd() % 4 {
+                            0 => Remember::T(Some(v)),
+                            1 => Remember::T(None),
+                            2 => Remember::Plane(Solved {
+                                plane: Plane {
+                                    row: v[0],
+                                    sx: v[1],
+                                    sy: v[2],
+                                },
+                                frac: (rnd() % 64) as u32,
+                            }),
+                            _ => {
+                                // `s0` below 64 and 1 more than the leading zeros below 16 fit the key; now and
+                                // then one beyond either.
+                                let (s0, lz) = (1 + rnd() % 70, rnd() % 18);
+                                Remember::Small(crate::small::Kept {
+                                    s_o: v[0] as u64,
+                                    sx: v[1] as u64,
+                                    sy: v[2] as u64,
+                                    shifts: core::num::NonZeroU16::new((s0 | lz << 8) as u16)
+                                        .unwrap(),
+                                })
+                            }
+                        };
+                        let fits = match r {
+                            Remember::Small(kept) => {
+                                kept.shifts.get() & 0xff <= 63 && kept.shifts.get() >> 8 <= 15
+                            }
+                            _ => true,
+                        };
+                        // Through `Remembered` (the draws' memo): kept only below the band's last row.
+                        let last = band_end - 1;
+                        let below = rnd().is_multiple_of(2);
+                        let mut memo = sealed::Remembered { cache, k, last };
+                        crate::setup::TMemo::keep(
+                            &mut memo,
+                            r,
+                            if below { last + 1 } else { last },
+                        );
+                        if below && fits && queue.len() < cap {
+                            queue.push_back((k, r));
+                        }
+                    }
+                }
+                assert_eq!(state.len.get(), queue.len(), "cap {cap}, step {step}");
+            }
+        }
+    }
+
     /// A list frame's draw (the memo draw, which snaps every vertex before it checks any `1/W`) reports the error
     /// [`Rasterizer::draw`] reports (its checks vertex by vertex: `z` and `1/W`, then the position, then `T`'s
     /// range), whatever mix of bad vertices a triangle has, and writes nothing: every vertex in each of seven kinds
