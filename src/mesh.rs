@@ -2202,6 +2202,79 @@ mod tests {
         }
     }
 
+    /// A triangle that crosses a plane is culled before it is clipped by its winding seen from the eye (the sign of
+    /// `det [x y w]` of its clip coordinates): exactly where what it would draw has the culled winding on screen.
+    /// Random triangles around the eye, each drawn with no culling (its fan triangles' screen areas, formed here) and
+    /// with each culling mode: a triangle whose every fan triangle of nonzero area runs clockwise is culled by `Cw`
+    /// and drawn whole by `Ccw`, and the other way round; a culled one counts once.
+    #[test]
+    fn a_clipped_triangle_is_culled_by_the_winding_it_would_draw() {
+        let cam = crate::projection::Camera::look_at(
+            [0.0; 3],
+            [0.3, -0.2, -1.0],
+            [0.0, 1.0, 0.0],
+            1.2,
+            1.0,
+            0.1,
+            50.0,
+        )
+        .unwrap();
+        let (m, vp) = (cam.matrix(), Viewport::new(0.0, 0.0, 64.0, 64.0));
+        let r = Rasterizer::<Fast>::new(cam.render_state().unwrap());
+        let mut rnd = crate::xorshift(0xC11F_C011_0000_0001);
+        let mut unit = move || (rnd() >> 40) as f32 / (1u64 << 24) as f32;
+        let (mut cw, mut ccw) = (0, 0);
+        for k in 0..20_000 {
+            let positions: [[f32; 3]; 3] =
+                core::array::from_fn(|_| core::array::from_fn(|_| unit() * 4.0 - 2.0));
+            let mesh = Mesh {
+                positions: &positions,
+                indices: &[[0, 1, 2]],
+                colors: Colors::Uniform(0u8),
+            };
+            let mut verts = [Projected::default(); 3];
+            let frame = r.transform_mesh(&mesh, &m, &vp, &mut verts).unwrap();
+            // The fan triangles `f` receives under `cull` (`None` for a clipped triangle), and the stats.
+            let draw = |cull: Cull| {
+                let (mut fans, mut stats) = (Vec::new(), Stats::default());
+                frame
+                    .for_each(cull, 0, 64, &mut stats, &|c, _| c[0], |k, v| {
+                        fans.push((k, v.map(|v| (v.x as f64, v.y as f64))));
+                        Ok::<_, ()>(Stats::default())
+                    })
+                    .unwrap();
+                (fans, stats.culled)
+            };
+            let (fans, _) = draw(Cull::None);
+            if fans.is_empty() || fans.iter().any(|(k, _)| k.is_some()) {
+                continue; // not clipped, or outside the view
+            }
+            // y down: a positive area runs clockwise on the display.
+            let areas: Vec<f64> = fans
+                .iter()
+                .map(|(_, [a, b, c])| (b.0 - a.0) * (c.1 - a.1) - (c.0 - a.0) * (b.1 - a.1))
+                .filter(|&a| a.abs() > 1e-6)
+                .collect();
+            let clockwise = if areas.iter().all(|&a| a > 0.0) {
+                cw += 1;
+                true
+            } else if areas.iter().all(|&a| a < 0.0) {
+                ccw += 1;
+                false
+            } else {
+                continue;
+            };
+            let (culls, keeps) = if clockwise {
+                (Cull::Cw, Cull::Ccw)
+            } else {
+                (Cull::Ccw, Cull::Cw)
+            };
+            assert_eq!(draw(culls), (Vec::new(), 1), "{k}: {positions:?}");
+            assert_eq!(draw(keeps), (fans, 0), "{k}: {positions:?}");
+        }
+        assert!(cw > 1000 && ccw > 1000, "{cw} {ccw}");
+    }
+
     /// Where the float test decides ([`clear_area`]), or the integer one ([`clear_area_fixed`]), the snapped area has its sign: on random triangles and on
     /// near-degenerate ones (a third vertex a few ulps off the line through two others, and tiny triangles), whose
     /// float and snapped areas often disagree, so the fallback is needed (asserted) and the bound is what decides.

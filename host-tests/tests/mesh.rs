@@ -390,13 +390,21 @@ fn bad_meshes_are_errors_and_write_nothing() {
 
 /// A closed cube with back faces culled covers each pixel at most once, with depth testing off: culling and the
 /// shared-edge fill rule leave neither gaps nor double writes. From inside the cube every face is a back face; with
-/// culling off, the walls around the eye (those beside and behind it crossing the eye plane, clipped) cover every
-/// pixel exactly once.
+/// culling off, and with the front faces culled (there are none), the walls around the eye (those beside and behind
+/// it crossing the eye plane, clipped, whose winding the clip decides before it clips) cover every pixel exactly once.
 #[test]
 fn a_closed_cube_writes_each_pixel_once_and_draws_from_inside() {
     let (pos, idx) = host_tests::cube();
     let vp = Viewport::new(0.0, 0.0, 64.0, 48.0);
-    for eye in [[3.0, 2.0, 5.0], [-4.0, -3.0, 2.5], [0.2, 0.1, 0.3]] {
+    let eyes = [
+        [3.0, 2.0, 5.0],
+        [-4.0, -3.0, 2.5],
+        [0.2, 0.1, 0.3],
+        [-0.6, 0.4, -0.2],
+        [0.7, -0.8, 0.5],
+    ];
+    let inside_culls = [wraster::Cull::None, wraster::Cull::Ccw];
+    for (eye, inside_cull) in eyes.iter().flat_map(|e| inside_culls.map(|c| (*e, c))) {
         let cam = Camera::look_at(
             eye,
             [0.0, 0.0, 0.0],
@@ -411,7 +419,7 @@ fn a_closed_cube_writes_each_pixel_once_and_draws_from_inside() {
         let mut state = cam.render_state().unwrap();
         state.mode = wraster::DepthMode::Off;
         if inside {
-            state.cull = wraster::Cull::None;
+            state.cull = inside_cull;
         }
         let mut r: Rasterizer = Rasterizer::new(state);
         let mut frame = Frame::new(64, 48);
@@ -440,7 +448,7 @@ fn a_closed_cube_writes_each_pixel_once_and_draws_from_inside() {
         );
         let covered = frame.writes.iter().filter(|&&n| n == 1).count();
         if inside {
-            assert_eq!(covered, 64 * 48, "eye {eye:?}: {stats:?}");
+            assert_eq!(covered, 64 * 48, "eye {eye:?}, {inside_cull:?}: {stats:?}");
         } else {
             assert!(covered > 150 && stats.culled >= 6, "eye {eye:?}: {stats:?}");
         }
