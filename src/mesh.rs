@@ -1491,6 +1491,39 @@ mod tests {
         assert!(found > 10_000, "{found}");
     }
 
+    /// [`Reach::any`] says whether a byte of the word is in reach (`b - lo <= span` modulo 256), for every `lo` and
+    /// every span the words take (under 128): random words, and words of bytes at the reach's edges.
+    #[test]
+    fn reach_finds_a_byte_in_reach_in_a_word() {
+        let mut rnd = crate::xorshift(0x4EAC_4000_0000_0001);
+        let (mut yes, mut no) = (0u32, 0u32);
+        for lo in 0..=255u8 {
+            for span in 0..128u8 {
+                let reach = Reach::new(lo, span);
+                for i in 0..40 {
+                    let w = if i % 2 == 0 {
+                        rnd() as u32
+                    } else {
+                        u32::from_le_bytes([0; 4].map(|_| match rnd() % 4 {
+                            0 => lo.wrapping_sub(1),
+                            1 => lo.wrapping_add(span).wrapping_add(1),
+                            2 => lo.wrapping_add(span),
+                            _ => lo,
+                        }))
+                    };
+                    let want = w.to_le_bytes().iter().any(|b| b.wrapping_sub(lo) <= span);
+                    assert_eq!(reach.any(w), want, "{lo} {span} {w:08x}");
+                    if want {
+                        yes += 1;
+                    } else {
+                        no += 1;
+                    }
+                }
+            }
+        }
+        assert!(yes > 100_000 && no > 100_000, "{yes} {no}");
+    }
+
     /// The bins of strips of small triangles whose tops run down 1.3 rows apart, every fifth one back-facing, every
     /// seventh one with a vertex to clip: 300 from row -20 (a range of 390 rows: buckets of 2 rows), 150 from row 100
     /// (193 rows: a bucket per row) and one alone. Each kept triangle's byte is the bucket of its top row
