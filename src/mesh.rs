@@ -2306,6 +2306,44 @@ mod tests {
             assert_eq!(draw(keeps), (fans, 0), "{k}: {positions:?}");
         }
         assert!(cw > 1000 && ccw > 1000, "{cw} {ccw}");
+        // Edge-on: a triangle in a plane through the eye (here `y = 0`, seen along `-z`: its clip `y` is 0 and so is
+        // `det`) covers no pixel, and is culled whatever the mode, counted once.
+        let cam = crate::projection::Camera::look_at(
+            [0.0; 3],
+            [0.0, 0.0, -1.0],
+            [0.0, 1.0, 0.0],
+            1.2,
+            1.0,
+            0.1,
+            50.0,
+        )
+        .unwrap();
+        let positions = [[1.0, 0.0, -2.0], [-1.0, 0.0, -0.05], [0.5, 0.0, 1.0]];
+        let mesh = Mesh {
+            positions: &positions,
+            indices: &[[0, 1, 2]],
+            colors: Colors::Uniform(0u8),
+        };
+        let mut verts = [Projected::default(); 3];
+        let frame = r
+            .transform_mesh(&mesh, &cam.matrix(), &vp, &mut verts)
+            .unwrap();
+        for cull in [Cull::None, Cull::Cw, Cull::Ccw] {
+            let mut stats = Stats::default();
+            frame
+                .for_each(
+                    cull,
+                    0,
+                    64,
+                    &mut stats,
+                    &|c, _| c[0],
+                    |k, v| -> Result<Stats, ()> {
+                        panic!("{cull:?}: drew {k:?} {:?}", v.map(|v| (v.x, v.y)))
+                    },
+                )
+                .unwrap();
+            assert_eq!(stats.culled, 1, "{cull:?}");
+        }
     }
 
     /// Where the float test decides ([`clear_area`]), or the integer one ([`clear_area_fixed`]), the snapped area has its sign: on random triangles and on
