@@ -2235,6 +2235,87 @@ mod tests {
         }
     }
 
+    /// A mesh with per-vertex colours through [`Rasterizer::draw_mesh_frame_gouraud`]: a triangle on screen draws
+    /// exactly what [`Rasterizer::draw_gouraud`] draws of its projected vertices with their own colours; a triangle
+    /// that crosses the near plane, with one colour at all three vertices, draws that colour at every pixel (the clip's
+    /// mix of three equal colours by weights that sum to 1 is that colour: each channel `c (1 + e) + 0.5` with
+    /// `|e| <= 3 2^-24`, under `2^-10` from `c + 0.5`, rounds down to `c`), over the pixels the flat draw covers.
+    #[cfg(feature = "gouraud")]
+    #[test]
+    fn per_vertex_colours_reach_the_gouraud_draw() {
+        use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
+        let cam = crate::projection::Camera::look_at(
+            [0.0, 0.0, 3.0],
+            [0.0; 3],
+            [0.0, 1.0, 0.0],
+            1.2,
+            1.0,
+            0.5,
+            50.0,
+        )
+        .unwrap();
+        let vp = Viewport::new(0.0, 0.0, 64.0, 64.0);
+        let mut r = Rasterizer::<Fast>::new(cam.render_state().unwrap());
+        r.state.cull = Cull::None;
+        let draw =
+            |r: &mut Rasterizer<Fast>, positions: &[[f32; 3]], colors: &[Rgb888], gouraud: bool| {
+                let mesh = Mesh {
+                    positions,
+                    indices: &[[0, 1, 2]],
+                    colors: if gouraud {
+                        Colors::PerVertex(colors)
+                    } else {
+                        Colors::Uniform(colors[0])
+                    },
+                };
+                let mut verts = [Projected::default(); 3];
+                let frame = r
+                    .transform_mesh(&mesh, &cam.matrix(), &vp, &mut verts)
+                    .unwrap();
+                let (mut px, mut z) = (vec![0u32; 64 * 64], vec![0u16; 64 * 64]);
+                let mut band = crate::ColorBand::<Rgb888>::new(&mut px, 64, 64).unwrap();
+                let mut depth = DepthBuffer::new(&mut z, 64, 64).unwrap();
+                depth.clear();
+                if gouraud {
+                    r.draw_mesh_frame_gouraud(&mut band, &mut depth, &frame)
+                        .unwrap();
+                } else {
+                    r.draw_mesh_frame(&mut band, &mut depth, &frame).unwrap();
+                }
+                (px, z, verts)
+            };
+        let colors = [Rgb888::RED, Rgb888::GREEN, Rgb888::BLUE];
+        let on_screen = [[-1.0, -0.8, 0.2], [1.1, -0.5, -0.4], [0.1, 1.0, 0.3]];
+        let (px, z, verts) = draw(&mut r, &on_screen, &colors, true);
+        let v: [crate::Vertex<Rgb888>; 3] = core::array::from_fn(|i| crate::Vertex {
+            x: verts[i].x,
+            y: verts[i].y,
+            z: 0.0,
+            rhw: verts[i].rhw,
+            color: colors[i],
+        });
+        let (mut px2, mut z2) = (vec![0u32; 64 * 64], vec![0u16; 64 * 64]);
+        let mut band = crate::ColorBand::<Rgb888>::new(&mut px2, 64, 64).unwrap();
+        let mut depth = DepthBuffer::new(&mut z2, 64, 64).unwrap();
+        depth.clear();
+        r.draw_gouraud(&mut band, &mut depth, &v).unwrap();
+        assert!(px == px2 && z == z2);
+        assert!(px.iter().filter(|&&c| c != 0).count() > 200);
+        // Crossing the near plane (the eye is at z = 3, the plane at 2.5).
+        let crossing = [[-1.0, -0.8, 0.0], [1.0, -0.6, 2.9], [0.2, 0.9, 0.5]];
+        let one = Rgb888::new(200, 121, 40);
+        let (px, _, _) = draw(&mut r, &crossing, &[one; 3], true);
+        let (flat, _, _) = draw(&mut r, &crossing, &[one; 3], false);
+        let raw = embedded_graphics_core::prelude::RawData::into_inner(
+            embedded_graphics_core::pixelcolor::raw::RawU24::from(one),
+        );
+        assert!(px
+            .iter()
+            .zip(&flat)
+            .all(|(&g, &f)| (g == 0) == (f == 0) && (g == 0 || g == raw)));
+        assert!(px.iter().filter(|&&c| c == raw).count() > 200);
+    }
+
     /// A triangle that crosses a plane is culled before it is clipped by its winding seen from the eye (the sign of
     /// `det [x y w]` of its clip coordinates): exactly where what it would draw has the culled winding on screen.
     /// Random triangles around the eye, each drawn with no culling (its fan triangles' screen areas, formed here) and
