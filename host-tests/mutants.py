@@ -71,7 +71,21 @@ def judge(m, wt):
         open(path, "w").write(orig)
 
 
+# The test files the judge leaves out (the property tests, the commands, the firmware runs); every other file of
+# host-tests/tests must be one of judge.rs's modules, or mutants it would catch are judged missed.
+NOT_JUDGED = {"commands.rs", "firmware.rs", "plan.rs", "precision_cmd.rs", "props.rs"}
+
+
+def unjudged_tests():
+    """The files of host-tests/tests that are neither judge.rs modules nor left out on purpose."""
+    judge = open(os.path.join(REPO, "host-tests", "mutants", "judge.rs")).read()
+    files = sorted(f for f in os.listdir(os.path.join(REPO, "host-tests", "tests")) if f.endswith(".rs"))
+    return [f for f in files if f not in NOT_JUDGED and f'#[path = "../tests/{f}"]' not in judge]
+
+
 def main():
+    missing = unjudged_tests()
+    assert not missing, f"host-tests/tests files the judge does not build: {missing} (add them to judge.rs)"
     args = sys.argv[1:]
     out = args.pop(0)
     jobs, only = 1, None

@@ -18,6 +18,8 @@ mod clip;
 mod coarse;
 #[path = "../tests/compare.rs"]
 mod compare;
+#[path = "../tests/cull.rs"]
+mod cull;
 #[path = "../tests/fixed_input.rs"]
 mod fixed_input;
 #[path = "../tests/formats.rs"]
