@@ -180,3 +180,186 @@ fn a_culled_mesh_draws_nothing_and_a_far_outside_one_is_culled() {
         "culled {culled}, drawn {drawn}, must {must}"
     );
 }
+
+/// The sphere is the one its doc describes, not merely one holding the points: the centre is the bounding box's
+/// centre rounded once to f32 (`lo / 2 + hi / 2`: both halves exact for normal numbers, one rounding in the sum),
+/// and the radius is the largest distance from it widened by no more than the doc's budget: the scaling, squares,
+/// sum and square root carry under `2^-21` relative, the widening is `2^-18` and the last product rounds by `2^-24`,
+/// so `radius <= d_max (1 + 2^-21)(1 + 2^-18)(1 + 2^-24) < d_max (1 + 2^-17)`. A cloud of one point (or of equal
+/// points) has radius 0 at that point.
+#[test]
+fn the_sphere_is_the_box_centre_and_the_farthest_point() {
+    let mut rnd = xorshift(0x5EED_0003);
+    let mut checked = 0;
+    for k in 0..400 {
+        let scale = 10f64.powf(-20.0 + 50.0 * (k as f64 / 399.0));
+        let off = [rnd() - 0.5, rnd() - 0.5, rnd() - 0.5].map(|v| v * scale * 4.0);
+        let n = 1 + (rnd() * 40.0) as usize;
+        let pos: Vec<[f32; 3]> = (0..n)
+            .map(|_| [0, 1, 2].map(|i| (off[i] + (rnd() - 0.5) * scale) as f32))
+            .collect();
+        let s = Sphere::enclosing(&pos).unwrap();
+        for i in 0..3 {
+            let lo = pos
+                .iter()
+                .map(|p| p[i] as f64)
+                .fold(f64::INFINITY, f64::min);
+            let hi = pos
+                .iter()
+                .map(|p| p[i] as f64)
+                .fold(f64::NEG_INFINITY, f64::max);
+            assert_eq!(s.center[i], ((lo + hi) / 2.0) as f32, "cloud {k} axis {i}");
+        }
+        let c = s.center.map(|v| v as f64);
+        let d_max = pos
+            .iter()
+            .map(|p| {
+                (0..3)
+                    .map(|i| (p[i] as f64 - c[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .fold(0.0, f64::max);
+        let r = s.radius as f64;
+        assert!(r >= d_max, "cloud {k}: {r} < {d_max}");
+        assert!(
+            r <= d_max * (1.0 + 2f64.powi(-17)),
+            "cloud {k}: radius {r} is {} of the farthest point's {d_max}",
+            r / d_max
+        );
+        checked += usize::from(d_max > 0.0);
+    }
+    assert!(checked > 350, "{checked}");
+    let one = Sphere::enclosing(&[[1.5, -2.0, 3.0], [1.5, -2.0, 3.0]]).unwrap();
+    assert_eq!(
+        one,
+        Sphere {
+            center: [1.5, -2.0, 3.0],
+            radius: 0.0
+        }
+    );
+}
+
+/// `Sphere::visible` against the exact test, on spheres placed at random around each of the six planes, within
+/// `2^-4` to `2^-26` of touching it (radii `|L(c)| / |a| (1 + delta)`): the planes in object space
+/// formed in f64 from the same f32 matrix, viewport and range (`L(c)` and `|a|` as the doc defines them; products of
+/// f32 values are exact in f64 and the sums err by some `2^-52`, far below what is asserted).
+/// - Where the exact sphere reaches inside every plane (`L(c) >= -r |a|` for all six), the cull keeps it: the doc's
+///   promise, "culled only when the exact test would cull it".
+/// - Where it lies outside one plane by more than the cull's margins (`-L(c) > r sqrt(|a|^2 + 2^-18 B) + 2^-15 T`,
+///   with `T` the sum of `L`'s terms' magnitudes and `B >= ` that of `|a|^2`), the cull rejects it: `d = -l - 2^-16 T`
+///   with `l` within `2^-20 T` of `L`, `a2 + 2^-20 b` within `2^-19 B` of `|a|^2 + 2^-20 B`, and the f32 squares
+///   and products within `2^-21`, so `d^2 > r^2 (a2 + 2^-20 b)` holds there.
+#[test]
+fn the_sphere_cull_is_the_exact_test_within_its_margins() {
+    let mut rnd = xorshift(0x5EED_0004);
+    let (mut kept_touching, mut culled_near, mut cases) = (0, 0, 0);
+    for k in 0..15_000 {
+        let (w, h) = (16 + (rnd() * 300.0) as u32, 16 + (rnd() * 300.0) as u32);
+        let near = 0.1 + rnd() * 2.0;
+        let far = near * (2.0 + rnd() * 500.0);
+        let cam = Camera::look_at(
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, -1.0],
+            [0.0, 1.0, 0.0],
+            0.3 + rnd() as f32 * 2.0,
+            w as f32 / h as f32,
+            near as f32,
+            far as f32,
+        )
+        .unwrap();
+        let model = Mat4::rotation_x((rnd() * 6.0) as f32)
+            * Mat4::rotation_y((rnd() * 6.0) as f32)
+            * Mat4::scale([0.5 + rnd() as f32, 0.5 + rnd() as f32, 0.5 + rnd() as f32])
+            * Mat4::translation([
+                ((rnd() - 0.5) * 4.0) as f32,
+                ((rnd() - 0.5) * 4.0) as f32,
+                -(near + rnd() * (far - near)) as f32,
+            ]);
+        let m = cam.model_matrix(&model);
+        // The whole target, a viewport inside it, or one with another clip rectangle.
+        let mut vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
+        if k % 3 == 1 {
+            vp = Viewport::new(3.0, 5.0, w as f32 * 0.75, h as f32 * 0.5);
+        } else if k % 3 == 2 {
+            (vp.clip_x, vp.clip_y, vp.clip_width, vp.clip_height) = (-0.8, 0.7, 1.7, 1.3);
+        }
+        let range = cam.render_state().unwrap().range;
+        // The six planes `ka (x or y) + kw w + kc >= 0` in clip space, exactly.
+        let (sx, sy) = (
+            vp.width as f64 / vp.clip_width as f64,
+            vp.height as f64 / vp.clip_height as f64,
+        );
+        let (ox, oy) = (
+            vp.x as f64 - vp.clip_x as f64 * sx,
+            vp.y as f64 + vp.clip_y as f64 * sy,
+        );
+        let (wd, ht) = (w as f64, h as f64);
+        let planes: [(usize, f64, f64, f64); 6] = [
+            (0, sx, ox, 0.0),
+            (0, -sx, wd - ox, 0.0),
+            (1, -sy, oy, 0.0),
+            (1, sy, ht - oy, 0.0),
+            (0, 0.0, 1.0, -range.near() as f64),
+            (0, 0.0, -1.0, range.far() as f64),
+        ];
+        let mm = m.0.map(|row| row.map(|v| v as f64));
+        // For centre `c`: per plane `(L(c), |a|, T, B)`.
+        let terms = |c: [f64; 3]| {
+            planes.map(|(axis, ka, kw, kc)| {
+                let a = [0, 1, 2].map(|i| ka * mm[i][axis] + kw * mm[i][3]);
+                let l = (0..3).map(|i| c[i] * a[i]).sum::<f64>()
+                    + ka * mm[3][axis]
+                    + kw * mm[3][3]
+                    + kc;
+                let t = (0..3)
+                    .map(|i| (ka * c[i] * mm[i][axis]).abs() + (kw * c[i] * mm[i][3]).abs())
+                    .sum::<f64>()
+                    + (ka * mm[3][axis]).abs()
+                    + (kw * mm[3][3]).abs()
+                    + kc.abs();
+                let b = (0..3)
+                    .map(|i| ((ka * mm[i][axis]).abs() + (kw * mm[i][3]).abs()).powi(2))
+                    .sum::<f64>();
+                (l, a.iter().map(|v| v * v).sum::<f64>().sqrt(), t, b)
+            })
+        };
+        // A centre anywhere in a box around the view, in object space: outside at least one plane most of the time.
+        let center = [0, 1, 2].map(|_| ((rnd() - 0.5) * 40.0) as f32);
+        let p = terms(center.map(|v| v as f64));
+        // Radius: touching one plane the centre is outside of, within `2^-26` to `2^-4`, either side.
+        let outside: Vec<usize> = (0..6).filter(|&j| p[j].0 < 0.0).collect();
+        if outside.is_empty() {
+            continue;
+        }
+        let j = outside[(rnd() * outside.len() as f64) as usize];
+        let delta = 2f64.powf(-4.0 - rnd() * 22.0) * if k % 2 == 0 { 1.0 } else { -1.0 };
+        let radius = (-p[j].0 / p[j].1 * (1.0 + delta)) as f32;
+        let sphere = Sphere { center, radius };
+        let r = radius as f64;
+        let visible = sphere.visible(&m, &vp, Size::new(w, h), &range);
+        cases += 1;
+        if p.iter().all(|&(l, a, _, _)| l >= -r * a) {
+            kept_touching += 1;
+            assert!(
+                visible,
+                "case {k}: the exact sphere reaches inside, the cull rejects it ({sphere:?})"
+            );
+        }
+        if p.iter()
+            .any(|&(l, a, t, b)| -l > r * (a * a + b * 2f64.powi(-18)).sqrt() + t * 2f64.powi(-15))
+        {
+            culled_near += 1;
+            assert!(
+                !visible,
+                "case {k}: outside beyond the margins, the cull keeps it ({sphere:?})"
+            );
+        }
+    }
+    // Both promises are put to the test near the planes, many times.
+    println!("cases {cases}, kept touching {kept_touching}, culled near {culled_near}");
+    assert!(
+        kept_touching > 1000 && culled_near > 1000,
+        "cases {cases}, kept touching {kept_touching}, culled near {culled_near}"
+    );
+}
