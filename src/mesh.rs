@@ -1888,6 +1888,127 @@ mod tests {
         assert!(first.1 != fresh.1);
     }
 
+    /// A band drawn another way than the band before it takes nothing that band kept: the cache's tag holds what its
+    /// entries depend on besides the triangle (`Rasterizer::memo_tag`). The torus's frame 0 in 8-row bands, rows 0
+    /// to 127 drawn one way and rows 128 on another with the same cache, against those rows drawn the second way with
+    /// a fresh one:
+    /// another near plane (a small triangle's remembered constants skip the range test's near side): `W_near` from the
+    /// camera's to 3.0, inside the depths of the torus's lower rows (from about 2.65), the frame transformed with the
+    /// camera's. The second way is seen to matter: its rows differ from the first way's. The strategies (whose entries
+    /// differ: the depth-grid values by another way, a small triangle's seed, planes for the exact tier) and another
+    /// far plane have tags of their own too.
+    #[test]
+    fn a_band_drawn_another_way_takes_nothing_from_the_last() {
+        use crate::recip::{Exact, FastDiv};
+        use crate::scenes::torus;
+        use embedded_graphics_core::pixelcolor::Rgb565;
+        type Rows = (Vec<u16>, Vec<u16>);
+        let (w, h) = (320u16, 240u16);
+        let (positions, indices, colors) = (torus::positions(), torus::indices(), torus::colors());
+        let mesh = Mesh {
+            positions: &positions,
+            indices: &indices,
+            colors: Colors::PerFace(&colors),
+        };
+        let cam = torus::camera().unwrap();
+        let state = cam.render_state().unwrap();
+        let m = cam.model_matrix(&torus::model(0));
+        let vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
+        // Bands from row `from` to `to` of `frame` into `out` (colour and depth).
+        fn bands<R: SpanRecip>(
+            r: &mut Rasterizer<R>,
+            frame: &CachedFrame<'_, Rgb565>,
+            (from, to): (u16, u16),
+            out: &mut Rows,
+        ) {
+            let (w, rows) = (320u16, 8u16);
+            for y0 in (from..to).step_by(rows as usize) {
+                let at = y0 as usize * w as usize..(y0 + rows) as usize * w as usize;
+                let mut band =
+                    crate::ColorBand::<Rgb565>::band(&mut out.0[at.clone()], w, y0 as i32, rows)
+                        .unwrap();
+                let mut depth = DepthBuffer::band(&mut out.1[at], w, y0 as i32, rows).unwrap();
+                depth.clear();
+                r.draw_mesh_frame(&mut band, &mut depth, frame).unwrap();
+            }
+        }
+        let blank = || -> Rows {
+            (
+                vec![0; w as usize * h as usize],
+                vec![0; w as usize * h as usize],
+            )
+        };
+        // Rows 128 on of `b` after rows 0 to 127 of `a` with one cache, and of `b` alone with a fresh one; and those
+        // rows of `a` alone.
+        fn check<A: SpanRecip, B: SpanRecip>(
+            a: &mut Rasterizer<A>,
+            b: &mut Rasterizer<B>,
+            frame: MeshFrame<'_, Rgb565>,
+            blank: &dyn Fn() -> Rows,
+            what: &str,
+        ) {
+            let (mut shared, mut fresh, mut first) = (blank(), blank(), blank());
+            let mut cache = PlaneCache::<200>::new();
+            let cached = frame.with_plane_cache(&mut cache);
+            bands(a, &cached, (0, 128), &mut shared);
+            bands(b, &cached, (128, 240), &mut shared);
+            let mut cache = PlaneCache::<200>::new();
+            bands(
+                b,
+                &frame.with_plane_cache(&mut cache),
+                (128, 240),
+                &mut fresh,
+            );
+            let mut cache = PlaneCache::<200>::new();
+            bands(
+                a,
+                &frame.with_plane_cache(&mut cache),
+                (128, 240),
+                &mut first,
+            );
+            let lower = 128 * 320..;
+            assert!(
+                shared.0[lower.clone()] == fresh.0[lower.clone()],
+                "{what}: colour"
+            );
+            assert!(
+                shared.1[lower.clone()] == fresh.1[lower.clone()],
+                "{what}: depth"
+            );
+            assert!(
+                first.1[lower.clone()] != fresh.1[lower],
+                "{what}: the two ways draw alike"
+            );
+        }
+        let mut verts = vec![Projected::default(); torus::VERTICES];
+        let mut near = state;
+        near.range = crate::DepthRange::new(3.0, state.range.far()).unwrap();
+        let (mut fast, mut fast_near) = (
+            Rasterizer::<Fast>::new(state),
+            Rasterizer::<Fast>::new(near),
+        );
+        let frame = fast.transform_mesh(&mesh, &m, &vp, &mut verts).unwrap();
+        check(&mut fast, &mut fast_near, frame, &blank, "near plane");
+        let (div, exact) = (
+            Rasterizer::<FastDiv>::new(state),
+            Rasterizer::<Exact>::new(state),
+        );
+        // The strategies draw these rows alike (the fast tiers' codes agree with the exact tier's here), so that the tag
+        // tells them apart is seen in the tags themselves: every pair of these ways has its own.
+        let tags = [
+            fast.memo_tag(),
+            fast_near.memo_tag(),
+            div.memo_tag(),
+            exact.memo_tag(),
+            Rasterizer::<Fast>::new(RenderState::new(0.5, 90.0).unwrap()).memo_tag(),
+        ];
+        for i in 0..tags.len() {
+            for j in 0..i {
+                assert_ne!(tags[i], tags[j], "ways {j} and {i}");
+            }
+        }
+    }
+
     /// The cache's ring against a model, a queue with a capacity: a band that follows the previous one (it begins
     /// where that one ended, with the same tag) finds what that band kept, in triangle order, and drops what it skips;
     /// any other band, and a reset, empty it; a full ring keeps nothing more. Every kind of value comes back as it was
