@@ -1077,6 +1077,143 @@ mod tests {
         check::<crate::recip::FastDiv>();
     }
 
+    /// A sliver off the snap grid whose depth-grid plane cannot be walked with its `T`'s fraction bits
+    /// ([`depth_plane`]'s `Err(Some(e))`) is solved with `e` fewer of them where more than [`MIN_FRAC`] remain; where
+    /// fewer would (`frac <= e + MIN_FRAC`), or the depth-grid triangle is degenerate (`Err(None)`), it takes the
+    /// snapped plane: the plane of the vertices' `T` through the snapped positions, which the same triangle given on
+    /// the snap grid draws. Random slivers of three kinds (the third vertex 10^-3 to 10^-7 px off the line through the
+    /// other two; exactly collinear positions off the snap grid; as nearly collinear as f32 allows, some 2^-40 px
+    /// wide, through a pixel centre), `W` from 1.5 to 400 at far/near 500 or from 1 to 2^21 at far/near 2^29 (`T` with
+    /// some 30 fraction bits, not 55), drawn by the exact tier (which takes no depth-grid values: the solve the general
+    /// set-up reaches for every triangle):
+    /// - each that takes the snapped plane draws what its snapped twin draws (codes, colours, statistics), among them
+    ///   some at the rule's edge, `frac = e + MIN_FRAC`, that cover pixels;
+    /// - most of those solved with fewer bits that cover pixels draw otherwise than their twins (their plane is the
+    ///   depth-grid one, through the vertices as given: across a sliver, the snap's rounding of under 1/512 px moves it
+    ///   by many codes).
+    #[test]
+    fn an_absurd_sliver_takes_the_snapped_plane_and_a_steep_one_fewer_bits() {
+        use crate::{ColorBand, DepthBuffer};
+        use embedded_graphics_core::pixelcolor::Rgb565;
+        let mut rnd = crate::xorshift(0x511B_E125_0000_0001);
+        let mut unit = move || (rnd() >> 11) as f64 / (1u64 << 53) as f64;
+        // Two depth ranges: far/near 500, and 2^29 (the vertices' `T` then has some 30 fraction bits, not 55).
+        let mut rs = [500.0, 536_870_900.0]
+            .map(|far| Rasterizer::<crate::recip::Exact>::new(RenderState::new(1.0, far).unwrap()));
+        let draw = |r: &mut Rasterizer<crate::recip::Exact>, v: &[Vertex<Rgb565>; 3]| {
+            let (mut cp, mut zp) = (std::vec![0u16; 128 * 128], std::vec![0u16; 128 * 128]);
+            let mut band = ColorBand::<Rgb565>::band(&mut cp, 128, 0, 128).unwrap();
+            let mut depth = DepthBuffer::band(&mut zp, 128, 0, 128).unwrap();
+            depth.clear();
+            let st = r.draw(&mut band, &mut depth, v).unwrap();
+            (cp, zp, st)
+        };
+        let (mut snapped, mut fewer, mut unlike, mut degenerate, mut edge) =
+            (0u32, 0u32, 0u32, 0u32, 0u32);
+        for k in 0..20_000 {
+            let r = &mut rs[k % 2];
+            let (x0, y0) = (5.0 + unit() * 50.0, 5.0 + unit() * 50.0);
+            let (len, a) = (10.0 + unit() * 100.0, unit() * core::f64::consts::TAU);
+            let (dx, dy) = (a.cos() * len * 0.6, a.sin() * len * 0.6);
+            let (f, off) = (unit(), 10f64.powf(-3.0 - unit() * 4.0));
+            let mut pos = [
+                (x0, y0),
+                (x0 + dx, y0 + dy),
+                (x0 + f * dx - a.sin() * off, y0 + f * dy + a.cos() * off),
+            ];
+            if k % 3 == 0 {
+                // Exactly collinear (multiples of 2^-12 px, exact in f32 and on any depth grid), off the snap grid:
+                // the depth-grid triangle is degenerate where the snapped one is not.
+                let g = |x: f64| (x * 4096.0).round() / 4096.0;
+                let (ex, ey) = (g(dx / 2.0), g(dy / 2.0));
+                pos = [
+                    (g(x0), g(y0)),
+                    (g(x0) + 2.0 * ex, g(y0) + 2.0 * ey),
+                    (g(x0) + ex, g(y0) + ey),
+                ];
+            } else if k % 3 == 1 {
+                // As nearly collinear as f32 allows: offsets of consecutive Fibonacci numbers of f32 steps (2^-18 px
+                // from 32 to 64 px), whose cross product is one step squared: a depth-grid triangle some 2^-40 px
+                // wide (the grid holds these positions exactly: 25 fraction bits below 64 px), up to 13 px long.
+                let mut fib = [1u32, 1, 2];
+                for _ in 0..20 + (unit() * 11.0) as u32 {
+                    fib = [fib[1], fib[2], fib[1] + fib[2]];
+                }
+                let u = 2f64.powi(-18);
+                let o = |a: u32, b: u32| if k % 4 < 2 { (a, b) } else { (b, a) };
+                let (p1, p2) = (o(fib[2], fib[1]), o(fib[1], fib[0]));
+                // The middle of the edge from the first vertex to the third within a step of a pixel centre (so
+                // that the snapped triangle, some 1/512 px wide, may cover it); every position from 36 to 63 px.
+                let (cx, cy) = (40.5 + (unit() * 8.0).floor(), 40.5 + (unit() * 8.0).floor());
+                let (bx, by) = (cx - (p2.0 / 2) as f64 * u, cy - (p2.1 / 2) as f64 * u);
+                pos = [
+                    (bx, by),
+                    (bx + p1.0 as f64 * u, by + p1.1 as f64 * u),
+                    (bx + p2.0 as f64 * u, by + p2.1 as f64 * u),
+                ];
+            }
+            // `W` from 1.5 to 400 with the nearer range, from 1 to 2^-8 of the far plane with the other.
+            let w = [0, 1, 2].map(|_| match k % 2 {
+                0 => 1.5 + unit() * unit() * 400.0,
+                _ => (unit() * 21.0).exp2(),
+            });
+            let c = Rgb565::new((k % 32) as u8, 7, 9);
+            let v: [Vertex<Rgb565>; 3] = core::array::from_fn(|i| {
+                Vertex::new(pos[i].0 as f32, pos[i].1 as f32, w[i] as f32, c)
+            });
+            let Ok(s) = r.setup(&v) else { continue };
+            let [p0, p1, p2] = s.p;
+            let area = (p1.x - p0.x) as i64 * (p2.y - p0.y) as i64
+                - (p2.x - p0.x) as i64 * (p1.y - p0.y) as i64;
+            if s.on_grid || area == 0 {
+                continue;
+            }
+            // `prepare_memo`'s orientation, then its first question to `depth_plane`.
+            let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };
+            let (p, q, t) = (
+                order.map(|k| s.p[k]),
+                order.map(|k| s.q[k]),
+                order.map(|k| s.t[k]),
+            );
+            let verdict = depth_plane(&p, &q, &t, s.dbits, s.dorigin);
+            let takes_snapped = match verdict {
+                Ok(_) => continue,
+                Err(None) => {
+                    degenerate += 1;
+                    true
+                }
+                Err(Some(e)) => s.frac <= e + MIN_FRAC,
+            };
+            // The twin: the snapped positions given exactly (multiples of 1/256 px), the same `1/W`.
+            let twin: [Vertex<Rgb565>; 3] = core::array::from_fn(|i| Vertex {
+                x: s.p[i].x as f32 / 256.0,
+                y: s.p[i].y as f32 / 256.0,
+                ..v[i]
+            });
+            let (a, b) = (draw(r, &v), draw(r, &twin));
+            if takes_snapped {
+                snapped += 1;
+                edge += u32::from(verdict == Err(Some(s.frac - MIN_FRAC)) && a.2.written > 0);
+                assert!(a == b, "sliver {k}: {verdict:?} with frac {}", s.frac);
+            } else {
+                if a.2.written + b.2.written > 0 {
+                    fewer += 1;
+                    unlike += u32::from(a.1 != b.1);
+                }
+            }
+        }
+        std::println!(
+            "snapped plane {snapped} ({degenerate} degenerate, {edge} at the edge with pixels), fewer bits {fewer} \
+             ({unlike} unlike the twin)"
+        );
+        assert!(edge >= 20, "{edge} at the rule's edge with pixels");
+        assert!(
+            snapped >= 20 && fewer >= 20,
+            "snapped plane {snapped}, fewer bits {fewer}"
+        );
+        assert!(unlike * 2 > fewer, "{unlike} of {fewer}");
+    }
+
     /// Both ways to the depth-grid plane's `T` at the snapped vertices ([`t_at_snapped_narrow`], and
     /// [`t_at_snapped_wide`] where it declines) stay within their stated bound, `T_min 2^-35`, of the exact value
     /// `t_k + (gx rx_k + gy ry_k) / A` (formed in `i128`), whenever they answer: random off-grid triangles of 1 to
