@@ -243,7 +243,9 @@ fn the_sphere_is_the_box_centre_and_the_farthest_point() {
 /// `Sphere::visible` against the exact test, on spheres placed at random around each of the six planes, within
 /// `2^-4` to `2^-26` of touching it (radii `|L(c)| / |a| (1 + delta)`): the planes in object space
 /// formed in f64 from the same f32 matrix, viewport and range (`L(c)` and `|a|` as the doc defines them; products of
-/// f32 values are exact in f64 and the sums err by some `2^-52`, far below what is asserted).
+/// f32 values are exact in f64 and the sums err by some `2^-52`, far below what is asserted). The model matrices are
+/// general (rotations, a non-uniform scale, a shear), and the viewports of several kinds, one with its clip corner at
+/// the origin (screen planes without a `w` term).
 /// - Where the exact sphere reaches inside every plane (`L(c) >= -r |a|` for all six), the cull keeps it: the doc's
 ///   promise, "culled only when the exact test would cull it".
 /// - Where it lies outside one plane by more than the cull's margins (`-L(c) > r sqrt(|a|^2 + 2^-18 B) + (2^-16 +
@@ -271,21 +273,36 @@ fn the_sphere_cull_is_the_exact_test_within_its_margins() {
             far as f32,
         )
         .unwrap();
+        // A general linear part (rotations, a non-uniform scale and a shear: the planes' normals then have all their
+        // Gram products, the cross terms of `|a|^2` too), then a translation in front of the eye.
+        let mut shear = Mat4::IDENTITY;
+        (shear.0[0][1], shear.0[1][2], shear.0[2][0]) = (
+            ((rnd() - 0.5) * 1.5) as f32,
+            ((rnd() - 0.5) * 1.5) as f32,
+            ((rnd() - 0.5) * 1.5) as f32,
+        );
         let model = Mat4::rotation_x((rnd() * 6.0) as f32)
             * Mat4::rotation_y((rnd() * 6.0) as f32)
             * Mat4::scale([0.5 + rnd() as f32, 0.5 + rnd() as f32, 0.5 + rnd() as f32])
+            * shear
             * Mat4::translation([
                 ((rnd() - 0.5) * 4.0) as f32,
                 ((rnd() - 0.5) * 4.0) as f32,
                 -(near + rnd() * (far - near)) as f32,
             ]);
         let m = cam.model_matrix(&model);
-        // The whole target, a viewport inside it, or one with another clip rectangle.
+        // The whole target, a viewport inside it, or one with another clip rectangle; some with its corner at the
+        // clip origin.
         let mut vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
         if k % 3 == 1 {
             vp = Viewport::new(3.0, 5.0, w as f32 * 0.75, h as f32 * 0.5);
         } else if k % 3 == 2 {
             (vp.clip_x, vp.clip_y, vp.clip_width, vp.clip_height) = (-0.8, 0.7, 1.7, 1.3);
+        }
+        if k % 4 == 3 {
+            // The clip rectangle's corner at the origin: the planes `x >= 0` and `y >= 0` have no `w` term, so their
+            // margin is all `|sx| g` (or `|sy| g`).
+            (vp.x, vp.y, vp.clip_x, vp.clip_y) = (0.0, 0.0, 0.0, 0.0);
         }
         let range = cam.render_state().unwrap().range;
         // The six planes `ka (x or y) + kw w + kc >= 0` in clip space, exactly.
