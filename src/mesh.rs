@@ -1898,6 +1898,7 @@ mod tests {
     /// differ: the depth-grid values by another way, a small triangle's seed, planes for the exact tier) and another
     /// far plane have tags of their own too.
     #[test]
+    #[cfg(feature = "scenes")]
     fn a_band_drawn_another_way_takes_nothing_from_the_last() {
         use crate::recip::{Exact, FastDiv};
         use crate::scenes::torus;
