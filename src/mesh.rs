@@ -1450,6 +1450,33 @@ mod tests {
         }
     }
 
+    /// W4's torus (its positions, indices and per-face colours), for the tests that draw it as a mesh.
+    #[cfg(feature = "scenes")]
+    struct TorusParts {
+        positions: [[f32; 3]; crate::scenes::torus::VERTICES],
+        indices: [[u16; 3]; crate::scenes::torus::TRIANGLES],
+        colors: [embedded_graphics_core::pixelcolor::Rgb565; crate::scenes::torus::TRIANGLES],
+    }
+
+    #[cfg(feature = "scenes")]
+    impl TorusParts {
+        fn new() -> Self {
+            use crate::scenes::torus;
+            TorusParts {
+                positions: torus::positions(),
+                indices: torus::indices(),
+                colors: torus::colors(),
+            }
+        }
+        fn mesh(&self) -> Mesh<'_, embedded_graphics_core::pixelcolor::Rgb565> {
+            Mesh {
+                positions: &self.positions,
+                indices: &self.indices,
+                colors: Colors::PerFace(&self.colors),
+            }
+        }
+    }
+
     #[test]
     fn the_word_scan_finds_what_the_byte_scan_finds() {
         // Every `lo`, reaches up to 127 (the words' limit) and past it, from starts at every alignment of the word
@@ -1673,12 +1700,8 @@ mod tests {
         use crate::scenes::torus;
         use embedded_graphics_core::pixelcolor::Rgb565;
         let (w, h) = (320u16, 240u16);
-        let (positions, indices, colors) = (torus::positions(), torus::indices(), torus::colors());
-        let mesh = Mesh {
-            positions: &positions,
-            indices: &indices,
-            colors: Colors::PerFace(&colors),
-        };
+        let torus_parts = TorusParts::new();
+        let mesh = torus_parts.mesh();
         let cam = torus::camera().unwrap();
         let mut r = Rasterizer::<R>::new(cam.render_state().unwrap());
         let vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
@@ -1844,12 +1867,8 @@ mod tests {
         use crate::scenes::torus;
         use embedded_graphics_core::pixelcolor::Rgb565;
         let (w, h, rows) = (320u16, 240u16, 8u16);
-        let (positions, indices, colors) = (torus::positions(), torus::indices(), torus::colors());
-        let mesh = Mesh {
-            positions: &positions,
-            indices: &indices,
-            colors: Colors::PerFace(&colors),
-        };
+        let torus_parts = TorusParts::new();
+        let mesh = torus_parts.mesh();
         let cam = torus::camera().unwrap();
         let mut r = Rasterizer::<Fast>::new(cam.render_state().unwrap());
         let vp = Viewport::new(0.0, 0.0, w as f32, h as f32);
@@ -1905,12 +1924,8 @@ mod tests {
         use embedded_graphics_core::pixelcolor::Rgb565;
         type Rows = (Vec<u16>, Vec<u16>);
         let (w, h) = (320u16, 240u16);
-        let (positions, indices, colors) = (torus::positions(), torus::indices(), torus::colors());
-        let mesh = Mesh {
-            positions: &positions,
-            indices: &indices,
-            colors: Colors::PerFace(&colors),
-        };
+        let torus_parts = TorusParts::new();
+        let mesh = torus_parts.mesh();
         let cam = torus::camera().unwrap();
         let state = cam.render_state().unwrap();
         let m = cam.model_matrix(&torus::model(0));
