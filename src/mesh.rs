@@ -335,17 +335,19 @@ impl<'a, C: Copy> DrawFrame<'a, C> for CachedFrame<'a, C> {}
 
 mod sealed {
     use super::{Cache, CachedFrame, MeshFrame, INDEX};
-    use crate::setup::{NoMemo, Remember, TMemo};
+    use crate::setup::{Culled, Remember, TMemo};
 
     /// Triangle `k`'s memo in a band whose last row is `last`: values from the cache, and kept for a triangle that
-    /// reaches further down.
-    pub struct Remembered<'a> {
+    /// reaches further down. `EARLY_CULL`: [`TMemo::EARLY_CULL`] (a list's triangles, not the mesh's, which it
+    /// culls itself).
+    pub struct Remembered<'a, const EARLY_CULL: bool> {
         pub(super) cache: Cache<'a>,
         pub(super) k: u32,
         pub(super) last: i32,
     }
 
-    impl TMemo for Remembered<'_> {
+    impl<const EARLY_CULL: bool> TMemo for Remembered<'_, EARLY_CULL> {
+        const EARLY_CULL: bool = EARLY_CULL;
         #[inline]
         fn take(&mut self) -> Option<Remember> {
             self.cache.take(self.k)
@@ -372,7 +374,7 @@ mod sealed {
 
     impl<'a, C> Frame<'a, C> for MeshFrame<'a, C> {
         type Memo<'m>
-            = NoMemo
+            = Culled
         where
             Self: 'm;
         #[inline(always)]
@@ -382,14 +384,14 @@ mod sealed {
         #[inline(always)]
         fn begin(&self, _: i32, _: u16, _: u64) {}
         #[inline(always)]
-        fn memo(&self, _: Option<usize>, _: i32) -> NoMemo {
-            NoMemo
+        fn memo(&self, _: Option<usize>, _: i32) -> Culled {
+            Culled
         }
     }
 
     impl<'a, C> Frame<'a, C> for CachedFrame<'a, C> {
         type Memo<'m>
-            = Option<Remembered<'m>>
+            = Option<Remembered<'m, false>>
         where
             Self: 'm;
         #[inline(always)]
@@ -401,7 +403,7 @@ mod sealed {
             self.cache.begin(y0, h, tag);
         }
         #[inline(always)]
-        fn memo(&self, k: Option<usize>, last: i32) -> Option<Remembered<'_>> {
+        fn memo(&self, k: Option<usize>, last: i32) -> Option<Remembered<'_, false>> {
             // Keys are 20 bits (`INDEX`): a triangle beyond is not cached.
             let k = u32::try_from(k?).ok().filter(|&k| k <= INDEX)?;
             Some(Remembered {
@@ -1212,7 +1214,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         let mut memo = u32::try_from(k)
             .ok()
             .filter(|&k| k <= INDEX)
-            .map(|k| sealed::Remembered {
+            .map(|k| sealed::Remembered::<true> {
                 cache: frame.cache,
                 k,
                 last,
@@ -1228,7 +1230,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
         t: &T,
-        memo: &mut Option<sealed::Remembered<'_>>,
+        memo: &mut Option<sealed::Remembered<'_, true>>,
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
@@ -1437,6 +1439,41 @@ mod tests {
     use crate::RenderState;
     use std::vec;
     use std::vec::Vec;
+
+    /// Draws `tris` into a frame of `w` x `h` pixels in bands of `rows` (bottom to top when `up`), each triangle `k`
+    /// with `draw(band, depth, k)` into a cleared band: the frame's RGB565 colours and W16 codes, and the statistics.
+    fn draw_in_bands(
+        (w, h): (usize, usize),
+        rows: usize,
+        up: bool,
+        n: usize,
+        mut draw: impl FnMut(
+            &mut crate::ColorBand<'_, embedded_graphics_core::pixelcolor::Rgb565>,
+            &mut DepthBuffer<'_>,
+            usize,
+        ) -> Stats,
+    ) -> (Vec<u16>, Vec<u16>, Stats) {
+        let (mut px, mut z) = (vec![0u16; w * h], vec![0u16; w * h]);
+        let mut stats = Stats::default();
+        let mut bands: Vec<usize> = (0..h).step_by(rows).collect();
+        if up {
+            bands.reverse();
+        }
+        for y0 in bands {
+            let bh = rows.min(h - y0);
+            let (mut cp, mut zp) = (vec![0u16; w * bh], vec![0u16; w * bh]);
+            let (width, top) = (w as u16, y0 as i32);
+            let mut band = crate::ColorBand::band(&mut cp, width, top, bh as u16).unwrap();
+            let mut depth = DepthBuffer::band(&mut zp, width, top, bh as u16).unwrap();
+            depth.clear();
+            for k in 0..n {
+                stats += draw(&mut band, &mut depth, k);
+            }
+            px[y0 * w..(y0 + bh) * w].copy_from_slice(band.pixels());
+            z[y0 * w..(y0 + bh) * w].copy_from_slice(depth.data());
+        }
+        (px, z, stats)
+    }
 
     /// A frame of screen vertices given as they are (as `transform_mesh` would leave them), in a 64 x 64 viewport.
     fn screen_frame<'a, C: Copy>(mesh: Mesh<'a, C>, verts: &'a [Projected]) -> MeshFrame<'a, C> {
@@ -2127,7 +2164,7 @@ mod tests {
                         // Through `Remembered` (the draws' memo): kept only below the band's last row.
                         let last = band_end - 1;
                         let below = rnd().is_multiple_of(2);
-                        let mut memo = sealed::Remembered { cache, k, last };
+                        let mut memo = sealed::Remembered::<false> { cache, k, last };
                         crate::setup::TMemo::keep(
                             &mut memo,
                             r,
@@ -2203,7 +2240,7 @@ mod tests {
     fn a_list_frame_draws_what_draw_draws_and_solves_each_plane_once() {
         use crate::setup::{PLANE_SOLVES, T_AT_SNAPPED_CALLS};
         use crate::small::SMALL_CONSTANTS;
-        use crate::{ColorBand, Vertex};
+        use crate::Vertex;
         use embedded_graphics_core::pixelcolor::{raw::RawU16, Rgb565};
         const W: usize = 96;
         const H: usize = 80;
@@ -2222,33 +2259,22 @@ mod tests {
             cache: Option<&mut PlaneCache<64>>,
             up: bool,
         ) -> Frame {
-            let (mut px, mut z) = (vec![0u16; W * H], vec![0u16; W * H]);
             let mut r = Rasterizer::<R>::new(RenderState::new(1.0, 500.0).unwrap());
-            let mut stats = Stats::default();
             PLANE_SOLVES.with(|c| c.borrow_mut().clear());
             T_AT_SNAPPED_CALLS.with(|c| c.borrow_mut().clear());
             SMALL_CONSTANTS.with(|c| c.borrow_mut().clear());
             let mut frame = cache.map(|c| c.list(tris));
-            let mut bands: Vec<usize> = (0..H).step_by(rows).collect();
-            if up {
-                bands.reverse();
-            }
-            for y0 in bands {
-                let h = rows.min(H - y0);
-                let (mut cp, mut zp) = (vec![0u16; W * h], vec![0u16; W * h]);
-                let mut band =
-                    ColorBand::<Rgb565>::band(&mut cp, W as u16, y0 as i32, h as u16).unwrap();
-                let mut depth = DepthBuffer::band(&mut zp, W as u16, y0 as i32, h as u16).unwrap();
-                depth.clear();
-                for (k, t) in tris.iter().enumerate() {
-                    stats += match &mut frame {
-                        Some(f) => r.draw_listed(&mut band, &mut depth, f, k).unwrap(),
-                        None => r.draw(&mut band, &mut depth, t).unwrap(),
-                    };
-                }
-                px[y0 * W..(y0 + h) * W].copy_from_slice(band.pixels());
-                z[y0 * W..(y0 + h) * W].copy_from_slice(depth.data());
-            }
+            let (px, z, stats) =
+                draw_in_bands(
+                    (W, H),
+                    rows,
+                    up,
+                    tris.len(),
+                    |band, depth, k| match &mut frame {
+                        Some(f) => r.draw_listed(band, depth, f, k).unwrap(),
+                        None => r.draw(band, depth, &tris[k]).unwrap(),
+                    },
+                );
             (
                 px,
                 z,
@@ -2338,6 +2364,138 @@ mod tests {
         // The lists have triangles the exact solve sets up, and small ones the small-triangle path draws, in more
         // than one band.
         assert!(again.0 && again.1);
+    }
+
+    /// A list's triangle off the snap grid that the render state culls is culled before the fast tier's depth-grid
+    /// values ([`t_at_snapped`](crate::setup::t_at_snapped) is never called for it), drawn alone, through a list
+    /// frame in bands, for both fast seeds and both windings culled; and culling it there draws what the draws
+    /// drew before: the frame, codes and statistics of the same list drawn without culling less the triangles whose
+    /// snapped doubled area (here from the f32 vertices in f64, rounded to 1/256 px ties to even) is zero or has the
+    /// culled sign. Random triangles of 1 to 110 px (the small path and the general set-up), a fifth of them
+    /// degenerate (the third vertex on the line through the first two, before rounding to f32).
+    #[test]
+    fn a_culled_triangle_off_the_grid_is_culled_before_its_depth_values() {
+        use crate::setup::T_AT_SNAPPED_CALLS;
+        use crate::{Cull, Vertex};
+        use embedded_graphics_core::pixelcolor::{raw::RawU16, Rgb565};
+        const W: usize = 96;
+        const H: usize = 80;
+        type Tri = [Vertex<Rgb565>; 3];
+        // A frame's colours and codes, its statistics and the snapped vertices of each `t_at_snapped` call.
+        type Frame = (Vec<u16>, Vec<u16>, Stats, Vec<[(i32, i32); 3]>);
+        let snap = |v: f32| (v as f64 * 256.0).round_ties_even() as i64;
+        let area = |t: &Tri| {
+            let p = t.map(|v| (snap(v.x), snap(v.y)));
+            (p[1].0 - p[0].0) * (p[2].1 - p[0].1) - (p[2].0 - p[0].0) * (p[1].1 - p[0].1)
+        };
+        let snapped = |t: &Tri| t.map(|v| (snap(v.x) as i32, snap(v.y) as i32));
+        let dropped = |cull: Cull, a: i64| match cull {
+            Cull::None => false,
+            Cull::Cw => a >= 0,
+            Cull::Ccw => a <= 0,
+        };
+        // Draws `tris` with `cull` in bands of `rows` (through a list frame when `listed`).
+        fn run<R: SpanRecip>(tris: &[Tri], cull: Cull, rows: usize, listed: bool) -> Frame {
+            let mut state = RenderState::new(1.0, 500.0).unwrap();
+            state.cull = cull;
+            let mut r = Rasterizer::<R>::new(state);
+            let mut cache = PlaneCache::<64>::new();
+            let frame = cache.list(tris);
+            T_AT_SNAPPED_CALLS.with(|c| c.borrow_mut().clear());
+            let (px, z, stats) = draw_in_bands(
+                (W, H),
+                rows,
+                false,
+                tris.len(),
+                |band, depth, k| match listed {
+                    true => r.draw_listed(band, depth, &frame, k).unwrap(),
+                    false => r.draw(band, depth, &tris[k]).unwrap(),
+                },
+            );
+            (px, z, stats, T_AT_SNAPPED_CALLS.with(|c| c.take()))
+        }
+        let mut rnd = crate::xorshift(0x0C0F_FEE5_CA11_ED00);
+        let mut unit = move || (rnd() >> 11) as f64 / (1u64 << 53) as f64;
+        let (mut culled_seen, mut kept_seen) = (0u32, 0u32);
+        for trial in 0..10 {
+            let tris: Vec<Tri> = (0..40)
+                .map(|k| {
+                    let size = [110.0, 40.0, 12.0, 3.0][k % 4];
+                    let (cx, cy) = (unit() * W as f64, unit() * H as f64);
+                    let c = Rgb565::from(RawU16::new((unit() * 65535.0) as u16));
+                    let mut p: [(f64, f64); 3] = core::array::from_fn(|_| {
+                        (cx + (unit() - 0.5) * size, cy + (unit() - 0.5) * size)
+                    });
+                    if (k + trial) % 5 == 0 {
+                        let f = unit();
+                        p[2] = (
+                            p[0].0 + (p[1].0 - p[0].0) * f,
+                            p[0].1 + (p[1].1 - p[0].1) * f,
+                        );
+                    }
+                    p.map(|(x, y)| {
+                        Vertex::new(x as f32, y as f32, (1.5 + unit() * 400.0) as f32, c)
+                    })
+                })
+                .collect();
+            fn check<R: SpanRecip>(
+                tris: &[Tri],
+                area: &impl Fn(&Tri) -> i64,
+                snapped: &impl Fn(&Tri) -> [(i32, i32); 3],
+                dropped: &impl Fn(Cull, i64) -> bool,
+                seen: (&mut u32, &mut u32),
+            ) {
+                for cull in [Cull::Cw, Cull::Ccw] {
+                    let kept: Vec<Tri> = tris
+                        .iter()
+                        .copied()
+                        .filter(|t| !dropped(cull, area(t)))
+                        .collect();
+                    let culled: Vec<[(i32, i32); 3]> = tris
+                        .iter()
+                        .filter(|t| dropped(cull, area(t)))
+                        .map(snapped)
+                        .collect();
+                    let expect = run::<R>(&kept, Cull::None, H, false);
+                    // The reference's areas are the draws': none of the kept triangles is degenerate to them.
+                    assert_eq!(expect.2.culled, 0);
+                    for (rows, listed) in [(H, false), (8, false), (8, true), (3, true)] {
+                        let got = run::<R>(tris, cull, rows, listed);
+                        assert!(
+                            got.0 == expect.0 && got.1 == expect.1,
+                            "{cull:?} {rows} {listed}: frame"
+                        );
+                        // Each band's draw of a culled triangle counts it (whether or not it has rows there).
+                        let bands = H.div_ceil(rows) as u32;
+                        assert_eq!(
+                            got.2.culled,
+                            culled.len() as u32 * bands,
+                            "{cull:?} {rows} {listed}"
+                        );
+                        assert_eq!(
+                            (got.2.fragments, got.2.written),
+                            (expect.2.fragments, expect.2.written),
+                            "{cull:?} {rows} {listed}"
+                        );
+                        assert!(
+                            got.3.iter().all(|p| !culled.contains(p)),
+                            "{cull:?} {rows} {listed}: the depth-grid values of a culled triangle"
+                        );
+                        *seen.0 += culled.len() as u32;
+                        *seen.1 += got.3.len() as u32;
+                    }
+                }
+            }
+            let seen = (&mut culled_seen, &mut kept_seen);
+            check::<crate::recip::Fast>(&tris, &area, &snapped, &dropped, seen);
+            let seen = (&mut culled_seen, &mut kept_seen);
+            check::<crate::recip::FastDiv>(&tris, &area, &snapped, &dropped, seen);
+        }
+        // The kept triangles' values were computed (the path is taken), and there were culled ones to skip.
+        assert!(
+            culled_seen > 1000 && kept_seen > 1000,
+            "{culled_seen} {kept_seen}"
+        );
     }
 
     /// `trunc_bits` (the cores without an FPU) is `as i32` (the FPU's conversion) on every class of f32: a stride

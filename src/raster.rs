@@ -31,7 +31,7 @@ use embedded_graphics_core::primitives::Rectangle;
 
 use crate::depth::{encode_w16, DepthBuffer, W16_FAR};
 use crate::edge::{Edge, Sub};
-use crate::fast::{Chord, Divide};
+use crate::fast::{smul_wide, Chord, Divide};
 use crate::fixed::{round_shift, split};
 use crate::input::VertexInput;
 #[cfg(feature = "gouraud")]
@@ -468,6 +468,23 @@ impl<R: SpanRecip> Rasterizer<R> {
         }
     }
 
+    /// Whether the render state's [`Cull`] drops the snapped triangle `p` (its doubled area: zero, or of the culled
+    /// sign), the test [`Rasterizer::prepare_memo`] and the small-triangle draw make again, before the work they need.
+    #[inline(always)]
+    fn culls(&self, p: &[Sub; 3]) -> bool {
+        // Snapped coordinates lie in the guard band (below 2^20 units): differences below 2^21, products below
+        // 2^42 (`smul_wide`: no `__aeabi_lmul` call on the Cortex-M0).
+        let area = || {
+            let [p0, p1, p2] = *p;
+            smul_wide(p1.x - p0.x, p2.y - p0.y) - smul_wide(p2.x - p0.x, p1.y - p0.y)
+        };
+        match self.state.cull {
+            Cull::None => false,
+            Cull::Cw => area() >= 0,
+            Cull::Ccw => area() <= 0,
+        }
+    }
+
     /// What a memo draw computes of `s` when nothing remembered stands in for it: the depth grid, and on the fast
     /// tier the depth-grid values off the snap grid.
     #[inline(always)]
@@ -521,6 +538,16 @@ impl<R: SpanRecip> Rasterizer<R> {
         } else {
             (self.setup(v)?, [0; 3])
         };
+        // A triangle off the snap grid that the render state culls, culled before its depth-grid values (the work
+        // of the fast tier's set-up that a culled one does not need; on one that is on the grid, and on the exact
+        // tier, the draws cull before any work of theirs). Where the caller culled by the same test (`M::EARLY_CULL`
+        // false: the mesh's draws), not tested twice.
+        if R::FAST_W16 && M::EARLY_CULL && !s.on_grid && self.culls(&s.p) {
+            return Ok(Stats {
+                culled: 1,
+                ..Stats::default()
+            });
+        }
         // Without a memo (`M::KEEPS` false, a constant: the branches below are not compiled) the values where a
         // path reads them, as ever. With one, what an earlier band of the frame remembered: the depth-grid values,
         // or the solved plane of a triangle the small-triangle path never takes (a fact of the triangle, whatever

@@ -121,6 +121,11 @@ pub enum Remember {
 pub trait TMemo {
     /// Whether this memo keeps anything ([`NoMemo`] does not: its draws compile to the code without a memo).
     const KEEPS: bool = true;
+    /// Whether a fast-tier draw tests the render state's [`crate::Cull`] before the depth-grid values of a triangle
+    /// off the snap grid, so that a culled one does not pay for them: where triangles reach the draw as they come
+    /// (lists). Not where the caller has culled them by the same test (the mesh's screen triangles): there the test
+    /// would only cost its instructions.
+    const EARLY_CULL: bool = true;
     /// What was remembered for this triangle, if anything (taken: each band keeps it again for the next).
     fn take(&mut self) -> Option<Remember>;
     /// This triangle's values, and its last row (the memo keeps them only for a triangle that reaches a later band).
@@ -128,6 +133,7 @@ pub trait TMemo {
 }
 
 impl<M: TMemo> TMemo for Option<M> {
+    const EARLY_CULL: bool = M::EARLY_CULL;
     #[inline(always)]
     fn take(&mut self) -> Option<Remember> {
         self.as_mut().and_then(|m| m.take())
@@ -142,6 +148,22 @@ impl<M: TMemo> TMemo for Option<M> {
 
 /// No memo: every draw computes its values.
 pub struct NoMemo;
+
+/// [`NoMemo`] for triangles the caller has culled with the draw's own test ([`TMemo::EARLY_CULL`] false): the mesh's
+/// (a piece of a clipped triangle, culled before clipping by its winding seen from the eye, that the render state
+/// still culls on the screen, a degenerate one, is culled by the draw after its values, as before this test).
+pub struct Culled;
+
+impl TMemo for Culled {
+    const KEEPS: bool = false;
+    const EARLY_CULL: bool = false;
+    #[inline(always)]
+    fn take(&mut self) -> Option<Remember> {
+        None
+    }
+    #[inline(always)]
+    fn keep(&mut self, _: Remember, _: i32) {}
+}
 
 impl TMemo for NoMemo {
     const KEEPS: bool = false;
