@@ -31,7 +31,7 @@ use embedded_graphics_core::primitives::Rectangle;
 
 use crate::depth::{encode_w16, DepthBuffer, W16_FAR};
 use crate::edge::{Edge, Sub};
-use crate::fast::{smul_wide, Chord, Divide};
+use crate::fast::{Chord, Divide};
 use crate::fixed::{round_shift, split};
 use crate::input::VertexInput;
 #[cfg(feature = "gouraud")]
@@ -43,8 +43,8 @@ use crate::setup::slope_bias;
 #[cfg(test)]
 use crate::setup::FAST_T_USED;
 use crate::setup::{
-    depth_plane, grid_bits, rows_of, t_at_snapped, Geom, Plane, Remember, Setup, Solved, Stats,
-    TMemo, MIN_FRAC, SUBPIXEL_BITS,
+    depth_plane, grid_bits, rows_of, t_at_snapped, t_at_snapped_unless_culled, Geom, Plane,
+    Remember, Setup, Solved, Stats, TMemo, MIN_FRAC, SUBPIXEL_BITS,
 };
 use crate::state::{Compare, DepthMode};
 use crate::state::{Cull, RenderState, MAX_T_LOG2};
@@ -458,40 +458,26 @@ impl<R: SpanRecip> Rasterizer<R> {
             | (R::DIV_SEED as u64) << 31
     }
 
-    /// The fast tier's depth-grid values of `s` ([`t_at_snapped`], the strategy's way).
+    /// The fast tier's depth-grid values of `s` ([`t_at_snapped`], the strategy's way); none for a triangle the
+    /// render state culls where `M` says the caller has not culled it ([`TMemo::EARLY_CULL`]): the draw culls it
+    /// before it reads them.
     #[inline(always)]
-    fn fast_t(&self, s: &Setup) -> Option<[i64; 3]> {
-        if R::DIV_SEED {
-            t_at_snapped::<true>(s)
-        } else {
-            t_at_snapped::<false>(s)
-        }
-    }
-
-    /// Whether the render state's [`Cull`] drops the snapped triangle `p` (its doubled area: zero, or of the culled
-    /// sign), the test [`Rasterizer::prepare_memo`] and the small-triangle draw make again, before the work they need.
-    #[inline(always)]
-    fn culls(&self, p: &[Sub; 3]) -> bool {
-        // Snapped coordinates lie in the guard band (below 2^20 units): differences below 2^21, products below
-        // 2^42 (`smul_wide`: no `__aeabi_lmul` call on the Cortex-M0).
-        let area = || {
-            let [p0, p1, p2] = *p;
-            smul_wide(p1.x - p0.x, p2.y - p0.y) - smul_wide(p2.x - p0.x, p1.y - p0.y)
-        };
-        match self.state.cull {
-            Cull::None => false,
-            Cull::Cw => area() >= 0,
-            Cull::Ccw => area() <= 0,
+    fn fast_t<M: TMemo>(&self, s: &Setup) -> Option<[i64; 3]> {
+        match (R::DIV_SEED, M::EARLY_CULL) {
+            (true, true) => t_at_snapped_unless_culled::<true>(s, self.state.cull),
+            (false, true) => t_at_snapped_unless_culled::<false>(s, self.state.cull),
+            (true, false) => t_at_snapped::<true>(s),
+            (false, false) => t_at_snapped::<false>(s),
         }
     }
 
     /// What a memo draw computes of `s` when nothing remembered stands in for it: the depth grid, and on the fast
     /// tier the depth-grid values off the snap grid.
     #[inline(always)]
-    fn depth_values<V: VertexInput>(&self, s: &mut Setup, v: &[V; 3]) {
+    fn depth_values<V: VertexInput, M: TMemo>(&self, s: &mut Setup, v: &[V; 3]) {
         Self::depth_grid(s, v);
         if R::FAST_W16 && !s.on_grid {
-            s.fast_t = self.fast_t(s);
+            s.fast_t = self.fast_t::<M>(s);
         }
     }
 
@@ -538,16 +524,6 @@ impl<R: SpanRecip> Rasterizer<R> {
         } else {
             (self.setup(v)?, [0; 3])
         };
-        // A triangle off the snap grid that the render state culls, culled before its depth-grid values (the work
-        // of the fast tier's set-up that a culled one does not need; on one that is on the grid, and on the exact
-        // tier, the draws cull before any work of theirs). Where the caller culled by the same test (`M::EARLY_CULL`
-        // false: the mesh's draws), not tested twice.
-        if R::FAST_W16 && M::EARLY_CULL && !s.on_grid && self.culls(&s.p) {
-            return Ok(Stats {
-                culled: 1,
-                ..Stats::default()
-            });
-        }
         // Without a memo (`M::KEEPS` false, a constant: the branches below are not compiled) the values where a
         // path reads them, as ever. With one, what an earlier band of the frame remembered: the depth-grid values,
         // or the solved plane of a triangle the small-triangle path never takes (a fact of the triangle, whatever
@@ -568,13 +544,13 @@ impl<R: SpanRecip> Rasterizer<R> {
                     Some(Remember::T(Some(t))) => s.fast_t = Some(t),
                     // Declined there (a steep plane): the general set-up solves it from the depth grid.
                     Some(Remember::T(None)) => Self::depth_grid(&mut s, v),
-                    None => self.depth_values(&mut s, v),
+                    None => self.depth_values::<_, M>(&mut s, v),
                 }
             } else {
                 Self::round_t(&mut s, te);
             }
         } else if R::FAST_W16 && !s.on_grid && in_buffer(&s.p, depth).is_some() {
-            s.fast_t = self.fast_t(&s);
+            s.fast_t = self.fast_t::<M>(&s);
         }
         // (A remembered small triangle's draw reads no depth-grid values: its constants stand for them.)
         #[cfg(test)]
@@ -633,7 +609,7 @@ impl<R: SpanRecip> Rasterizer<R> {
             let te;
             (s, te) = assemble(s.p, s.on_grid, tm, int_bits);
             Self::round_t(&mut s, te);
-            self.depth_values(&mut s, v);
+            self.depth_values::<_, M>(&mut s, v);
         }
         let (mut w, solved) =
             match self.prepare_memo(&s, (depth.y0(), depth.height()), R::FAST_W16, solved)? {
