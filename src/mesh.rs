@@ -338,16 +338,21 @@ mod sealed {
     use crate::setup::{Culled, Remember, TMemo};
 
     /// Triangle `k`'s memo in a band whose last row is `last`: values from the cache, and kept for a triangle that
-    /// reaches further down. `EARLY_CULL`: [`TMemo::EARLY_CULL`] (a list's triangles, not the mesh's, which it
-    /// culls itself).
-    pub struct Remembered<'a, const EARLY_CULL: bool> {
+    /// reaches further down. No early cull ([`TMemo::early_cull`]), for a mesh's triangles (culled first) and a
+    /// list's alike: one instance of the draw for both (with the test a list's, without it a mesh's, they were two, and
+    /// a firmware drawing both held 9,316 more bytes of `.text`; and as a value, the M0's W4 frame took 0.15% more
+    /// instructions). A list frame's culled triangle computes its values once a frame, kept for its later bands.
+    pub struct Remembered<'a> {
         pub(super) cache: Cache<'a>,
         pub(super) k: u32,
         pub(super) last: i32,
     }
 
-    impl<const EARLY_CULL: bool> TMemo for Remembered<'_, EARLY_CULL> {
-        const EARLY_CULL: bool = EARLY_CULL;
+    impl TMemo for Remembered<'_> {
+        #[inline(always)]
+        fn early_cull(&self) -> bool {
+            false
+        }
         #[inline]
         fn take(&mut self) -> Option<Remember> {
             self.cache.take(self.k)
@@ -391,7 +396,7 @@ mod sealed {
 
     impl<'a, C> Frame<'a, C> for CachedFrame<'a, C> {
         type Memo<'m>
-            = Option<Remembered<'m, false>>
+            = Option<Remembered<'m>>
         where
             Self: 'm;
         #[inline(always)]
@@ -403,7 +408,7 @@ mod sealed {
             self.cache.begin(y0, h, tag);
         }
         #[inline(always)]
-        fn memo(&self, k: Option<usize>, last: i32) -> Option<Remembered<'_, false>> {
+        fn memo(&self, k: Option<usize>, last: i32) -> Option<Remembered<'_>> {
             // Keys are 20 bits (`INDEX`): a triangle beyond is not cached.
             let k = u32::try_from(k?).ok().filter(|&k| k <= INDEX)?;
             Some(Remembered {
@@ -1214,7 +1219,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         let mut memo = u32::try_from(k)
             .ok()
             .filter(|&k| k <= INDEX)
-            .map(|k| sealed::Remembered::<true> {
+            .map(|k| sealed::Remembered {
                 cache: frame.cache,
                 k,
                 last,
@@ -1230,7 +1235,7 @@ impl<R: SpanRecip> Rasterizer<R> {
         target: &mut D,
         depth: &mut DepthBuffer<'_>,
         t: &T,
-        memo: &mut Option<sealed::Remembered<'_, true>>,
+        memo: &mut Option<sealed::Remembered<'_>>,
     ) -> Result<Stats, Error>
     where
         D: DrawTarget,
@@ -2164,7 +2169,7 @@ mod tests {
                         // Through `Remembered` (the draws' memo): kept only below the band's last row.
                         let last = band_end - 1;
                         let below = rnd().is_multiple_of(2);
-                        let mut memo = sealed::Remembered::<false> { cache, k, last };
+                        let mut memo = sealed::Remembered { cache, k, last };
                         crate::setup::TMemo::keep(
                             &mut memo,
                             r,
@@ -2367,9 +2372,10 @@ mod tests {
     }
 
     /// A list's triangle off the snap grid that the render state culls is culled before the fast tier's depth-grid
-    /// values ([`t_at_snapped`](crate::setup::t_at_snapped) is never called for it), drawn alone, through a list
-    /// frame in bands, for both fast seeds and both windings culled; and culling it there draws what the draws
-    /// drew before: the frame, codes and statistics of the same list drawn without culling less the triangles whose
+    /// values when drawn alone ([`t_at_snapped`](crate::setup::t_at_snapped) is never called for it; a list frame's
+    /// draws, which share the mesh's memo, compute them), in bands, for both fast seeds and both windings culled; and
+    /// culling it there draws what the draws drew before, alone and through a list frame in bands: the frame, codes
+    /// and statistics of the same list drawn without culling less the triangles whose
     /// snapped doubled area (here from the f32 vertices in f64, rounded to 1/256 px ties to even) is zero or has the
     /// culled sign. Random triangles of 1 to 110 px (the small path and the general set-up), a fifth of them
     /// degenerate (the third vertex on the line through the first two, before rounding to f32).
@@ -2477,12 +2483,14 @@ mod tests {
                             (expect.2.fragments, expect.2.written),
                             "{cull:?} {rows} {listed}"
                         );
-                        assert!(
-                            got.3.iter().all(|p| !culled.contains(p)),
-                            "{cull:?} {rows} {listed}: the depth-grid values of a culled triangle"
-                        );
-                        *seen.0 += culled.len() as u32;
-                        *seen.1 += got.3.len() as u32;
+                        if !listed {
+                            assert!(
+                                got.3.iter().all(|p| !culled.contains(p)),
+                                "{cull:?} {rows}: the depth-grid values of a culled triangle"
+                            );
+                            *seen.0 += culled.len() as u32;
+                            *seen.1 += got.3.len() as u32;
+                        }
                     }
                 }
             }

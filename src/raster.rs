@@ -459,11 +459,11 @@ impl<R: SpanRecip> Rasterizer<R> {
     }
 
     /// The fast tier's depth-grid values of `s` ([`t_at_snapped`], the strategy's way); none for a triangle the
-    /// render state culls where `M` says the caller has not culled it ([`TMemo::EARLY_CULL`]): the draw culls it
-    /// before it reads them.
+    /// render state culls where the memo says the caller has not culled it (`early`, [`TMemo::early_cull`]): the
+    /// draw culls it before it reads them.
     #[inline(always)]
-    fn fast_t<M: TMemo>(&self, s: &Setup) -> Option<[i64; 3]> {
-        match (R::DIV_SEED, M::EARLY_CULL) {
+    fn fast_t(&self, s: &Setup, early: bool) -> Option<[i64; 3]> {
+        match (R::DIV_SEED, early) {
             (true, true) => t_at_snapped_unless_culled::<true>(s, self.state.cull),
             (false, true) => t_at_snapped_unless_culled::<false>(s, self.state.cull),
             (true, false) => t_at_snapped::<true>(s),
@@ -474,10 +474,10 @@ impl<R: SpanRecip> Rasterizer<R> {
     /// What a memo draw computes of `s` when nothing remembered stands in for it: the depth grid, and on the fast
     /// tier the depth-grid values off the snap grid.
     #[inline(always)]
-    fn depth_values<V: VertexInput, M: TMemo>(&self, s: &mut Setup, v: &[V; 3]) {
+    fn depth_values<V: VertexInput>(&self, s: &mut Setup, v: &[V; 3], early: bool) {
         Self::depth_grid(s, v);
         if R::FAST_W16 && !s.on_grid {
-            s.fast_t = self.fast_t::<M>(s);
+            s.fast_t = self.fast_t(s, early);
         }
     }
 
@@ -544,13 +544,13 @@ impl<R: SpanRecip> Rasterizer<R> {
                     Some(Remember::T(Some(t))) => s.fast_t = Some(t),
                     // Declined there (a steep plane): the general set-up solves it from the depth grid.
                     Some(Remember::T(None)) => Self::depth_grid(&mut s, v),
-                    None => self.depth_values::<_, M>(&mut s, v),
+                    None => self.depth_values(&mut s, v, memo.early_cull()),
                 }
             } else {
                 Self::round_t(&mut s, te);
             }
         } else if R::FAST_W16 && !s.on_grid && in_buffer(&s.p, depth).is_some() {
-            s.fast_t = self.fast_t::<M>(&s);
+            s.fast_t = self.fast_t(&s, memo.early_cull());
         }
         // (A remembered small triangle's draw reads no depth-grid values: its constants stand for them.)
         #[cfg(test)]
@@ -609,7 +609,7 @@ impl<R: SpanRecip> Rasterizer<R> {
             let te;
             (s, te) = assemble(s.p, s.on_grid, tm, int_bits);
             Self::round_t(&mut s, te);
-            self.depth_values::<_, M>(&mut s, v);
+            self.depth_values(&mut s, v, memo.early_cull());
         }
         let (mut w, solved) =
             match self.prepare_memo(&s, (depth.y0(), depth.height()), R::FAST_W16, solved)? {

@@ -125,8 +125,12 @@ pub trait TMemo {
     /// Whether a fast-tier draw tests the render state's [`crate::Cull`] before the depth-grid values of a triangle
     /// off the snap grid, so that a culled one does not pay for them: where triangles reach the draw as they come
     /// (lists). Not where the caller has culled them by the same test (the mesh's screen triangles): there the test
-    /// would only cost its instructions.
-    const EARLY_CULL: bool = true;
+    /// would only cost its instructions. Nor with a plane cache (`crate::mesh`'s memo: one instance of the draw for
+    /// a list frame's triangles and a mesh's, whose values it keeps across bands).
+    #[inline(always)]
+    fn early_cull(&self) -> bool {
+        true
+    }
     /// What was remembered for this triangle, if anything (taken: each band keeps it again for the next).
     fn take(&mut self) -> Option<Remember>;
     /// This triangle's values, and its last row (the memo keeps them only for a triangle that reaches a later band).
@@ -134,7 +138,10 @@ pub trait TMemo {
 }
 
 impl<M: TMemo> TMemo for Option<M> {
-    const EARLY_CULL: bool = M::EARLY_CULL;
+    #[inline(always)]
+    fn early_cull(&self) -> bool {
+        self.as_ref().is_some_and(|m| m.early_cull())
+    }
     #[inline(always)]
     fn take(&mut self) -> Option<Remember> {
         self.as_mut().and_then(|m| m.take())
@@ -150,14 +157,17 @@ impl<M: TMemo> TMemo for Option<M> {
 /// No memo: every draw computes its values.
 pub struct NoMemo;
 
-/// [`NoMemo`] for triangles the caller has culled with the draw's own test ([`TMemo::EARLY_CULL`] false): the mesh's
+/// [`NoMemo`] for triangles the caller has culled with the draw's own test ([`TMemo::early_cull`] false): the mesh's
 /// (a piece of a clipped triangle, culled before clipping by its winding seen from the eye, that the render state
 /// still culls on the screen, a degenerate one, is culled by the draw after its values, as before this test).
 pub struct Culled;
 
 impl TMemo for Culled {
     const KEEPS: bool = false;
-    const EARLY_CULL: bool = false;
+    #[inline(always)]
+    fn early_cull(&self) -> bool {
+        false
+    }
     #[inline(always)]
     fn take(&mut self) -> Option<Remember> {
         None
@@ -316,7 +326,7 @@ pub(crate) fn t_at_snapped<const NARROW: bool>(s: &Setup) -> Option<[i64; 3]> {
 
 /// [`t_at_snapped`] of a triangle as it reaches a draw of a list: none, without their work, where the render state's
 /// `cull` drops it (a culled triangle reads no values; the draw culls it by the same test before it would), where a
-/// triangle of a mesh is culled before its draw ([`TMemo::EARLY_CULL`]). Out of line beside it: the terrain drawn
+/// triangle of a mesh is culled before its draw ([`TMemo::early_cull`]). Out of line beside it: the terrain drawn
 /// with [`Cull::Ccw`] on the M4 takes 23.7% fewer instructions (README, "Culling a list's triangles"), and a draw that
 /// never culls keeps its code but for the call's argument (a culled triangle's early return from the draw itself saved
 /// more, but took the M0's standard scenes 72 bytes deeper into its stack).
