@@ -1080,6 +1080,72 @@ mod tests {
         check::<crate::recip::FastDiv>();
     }
 
+    /// The memo draws' set-up (`setup_snapped_first`, which snaps every vertex before it computes any `T`, then finds
+    /// the error with `snap_error`) reports the error every other draw's (`setup_unrounded`) does, in its order:
+    /// vertex by vertex, `1/W`, then the position, then `T`'s range. Every triangle whose vertices are each good, bad
+    /// in position, bad in `1/W`, or both (64 patterns), with each pair of bad values: positions NaN, infinite and
+    /// beyond the guard band; `1/W` NaN, zero, negative and so large that `T` leaves its range.
+    #[test]
+    fn the_memo_set_up_reports_the_error_the_others_do() {
+        let r = Rasterizer::<crate::recip::Fast>::new(RenderState::new(1.0, 100.0).unwrap());
+        let good = [
+            (10.3f32, 10.7f32, 0.5f32),
+            (60.1, 12.9, 0.25),
+            (30.6, 50.2, 0.125),
+        ];
+        let bad_pos = [f32::NAN, f32::INFINITY, 1.0e9];
+        let bad_rhw = [f32::NAN, 0.0, -1.0, 1.0e30];
+        // (the same vertex bad in `1/W` and position, reported as `1/W`'s; bad in `T`'s range and position, as the
+        // position's)
+        let (mut errors, mut rhw_first, mut position_first) = (0, 0, 0);
+        for pattern in 0..64usize {
+            for (pi, &bp) in bad_pos.iter().enumerate() {
+                for (ri, &br) in bad_rhw.iter().enumerate() {
+                    let v: [Vertex<()>; 3] = core::array::from_fn(|k| {
+                        let (mut x, y, mut rhw) = good[k];
+                        let kind = (pattern >> (2 * k)) & 3;
+                        if kind & 1 != 0 {
+                            x = bp;
+                        }
+                        if kind & 2 != 0 {
+                            rhw = br;
+                        }
+                        Vertex {
+                            x,
+                            y,
+                            z: 0.0,
+                            rhw,
+                            color: (),
+                        }
+                    });
+                    let want = r.setup_unrounded(&v).err();
+                    let got = r.setup_snapped_first(&v, |_| true).err();
+                    assert_eq!(got, want, "pattern {pattern:06b}, position {pi}, 1/W {ri}");
+                    errors += want.is_some() as u32;
+                    // The first bad vertex bad in both ways.
+                    let first = (0..3)
+                        .map(|k| (pattern >> (2 * k)) & 3)
+                        .find(|&kind| kind != 0);
+                    if first == Some(3) {
+                        match want {
+                            Some(Error::DepthRange) => {}
+                            Some(Error::RhwNotPositive) => rhw_first += 1,
+                            Some(Error::NonFinite) if ri == 0 => rhw_first += 1,
+                            Some(_) => position_first += 1,
+                            None => {}
+                        }
+                    }
+                }
+            }
+        }
+        // Every case with a bad vertex is an error, and both orders within one vertex were reached.
+        assert_eq!(errors, 63 * 12);
+        assert!(
+            rhw_first > 0 && position_first > 0,
+            "{rhw_first} {position_first}"
+        );
+    }
+
     /// A sliver off the snap grid whose depth-grid plane cannot be walked with its `T`'s fraction bits
     /// ([`depth_plane`]'s `Err(Some(e))`) is solved with `e` fewer of them where more than [`MIN_FRAC`] remain; where
     /// fewer would (`frac <= e + MIN_FRAC`), or the depth-grid triangle is degenerate (`Err(None)`), it takes the
