@@ -335,7 +335,7 @@ impl<'a, C: Copy> DrawFrame<'a, C> for CachedFrame<'a, C> {}
 
 mod sealed {
     use super::{Cache, CachedFrame, MeshFrame, INDEX};
-    use crate::setup::{Culled, Remember, TMemo};
+    use crate::setup::{Culled, NoMemo, Remember, TMemo};
 
     /// Triangle `k`'s memo in a band whose last row is `last`: values from the cache, and kept for a triangle that
     /// reaches further down. No early cull ([`TMemo::early_cull`]), for a mesh's triangles (culled first) and a
@@ -390,7 +390,7 @@ mod sealed {
         fn begin(&self, _: i32, _: u16, _: u64) {}
         #[inline(always)]
         fn memo(&self, _: Option<usize>, _: i32) -> Culled {
-            Culled
+            NoMemo
         }
     }
 

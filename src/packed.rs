@@ -489,13 +489,7 @@ impl<R: WSpan> Rasterizer<R> {
         let [p0, p1, p2] = s.p;
         let area = (p1.x - p0.x) as i64 * (p2.y - p0.y) as i64
             - (p2.x - p0.x) as i64 * (p1.y - p0.y) as i64;
-        let culled = match self.state.cull {
-            _ if area == 0 => true,
-            crate::Cull::Cw => area > 0,
-            crate::Cull::Ccw => area < 0,
-            crate::Cull::None => false,
-        };
-        if culled {
+        if crate::setup::culls_area(self.state.cull, area) {
             return Ok(Stats {
                 culled: 1,
                 ..Stats::default()

@@ -47,7 +47,7 @@ use crate::setup::{
     Remember, Setup, Solved, Stats, TMemo, MIN_FRAC, SUBPIXEL_BITS,
 };
 use crate::state::{Compare, DepthMode};
-use crate::state::{Cull, RenderState, MAX_T_LOG2};
+use crate::state::{RenderState, MAX_T_LOG2};
 use crate::Error;
 #[cfg(feature = "gouraud")]
 use embedded_graphics_core::pixelcolor::{Rgb888, RgbColor};
@@ -290,11 +290,8 @@ impl<R: WSpan> Rasterizer<R> {
             culled: 1,
             ..Stats::default()
         };
-        match self.state.cull {
-            _ if area == 0 => return Ok(Err(culled)),
-            Cull::Cw if area > 0 => return Ok(Err(culled)),
-            Cull::Ccw if area < 0 => return Ok(Err(culled)),
-            _ => {}
+        if crate::setup::culls_area(self.state.cull, area) {
+            return Ok(Err(culled));
         }
         // Orient so the doubled area is positive (inside = positive edge functions).
         let order = if area < 0 { [0, 2, 1] } else { [0, 1, 2] };

@@ -541,7 +541,7 @@ impl<R: SpanRecip> WSpan for R {
         D: embedded_graphics_core::draw_target::DrawTarget,
         D::Color: embedded_graphics_core::pixelcolor::PixelColor,
     {
-        r.draw_memo(target, depth, v, &mut crate::setup::NoMemo)
+        r.draw_memo(target, depth, v, &mut crate::setup::NoMemo::<true>)
     }
     #[inline(always)]
     fn walk<E>(

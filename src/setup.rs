@@ -154,30 +154,21 @@ impl<M: TMemo> TMemo for Option<M> {
     }
 }
 
-/// No memo: every draw computes its values.
-pub struct NoMemo;
+/// No memo: every draw computes its values. `EARLY_CULL` is its [`TMemo::early_cull`]: true for triangles as they
+/// come ([`crate::Rasterizer::draw`]), false ([`Culled`]) for triangles the caller has culled with the draw's own test.
+pub struct NoMemo<const EARLY_CULL: bool = true>;
 
-/// [`NoMemo`] for triangles the caller has culled with the draw's own test ([`TMemo::early_cull`] false): the mesh's
-/// (a piece of a clipped triangle, culled before clipping by its winding seen from the eye, that the render state
-/// still culls on the screen, a degenerate one, is culled by the draw after its values, as before this test).
-pub struct Culled;
+/// [`NoMemo`] for triangles the caller has culled with the draw's own test: the mesh's (a piece of a clipped
+/// triangle, culled before clipping by its winding seen from the eye, that the render state still culls on the
+/// screen, or a degenerate one, is culled by the draw after its values, as before this test).
+pub type Culled = NoMemo<false>;
 
-impl TMemo for Culled {
+impl<const EARLY_CULL: bool> TMemo for NoMemo<EARLY_CULL> {
     const KEEPS: bool = false;
     #[inline(always)]
     fn early_cull(&self) -> bool {
-        false
+        EARLY_CULL
     }
-    #[inline(always)]
-    fn take(&mut self) -> Option<Remember> {
-        None
-    }
-    #[inline(always)]
-    fn keep(&mut self, _: Remember, _: i32) {}
-}
-
-impl TMemo for NoMemo {
-    const KEEPS: bool = false;
     #[inline(always)]
     fn take(&mut self) -> Option<Remember> {
         None
@@ -341,20 +332,35 @@ pub(crate) fn t_at_snapped_unless_culled<const NARROW: bool>(
     t_at_snapped::<NARROW>(s)
 }
 
-/// Whether `cull` drops the snapped triangle `p`: its doubled area zero, or of the culled sign (the test of
-/// [`crate::Rasterizer::draw`]'s set-ups). Snapped coordinates lie in the guard band (below `2^20` units): differences
-/// below `2^21`, products below `2^42` ([`crate::fast::smul_wide`]: no `__aeabi_lmul` call on the Cortex-M0).
+/// The draw's cull rule on the doubled area of a snapped triangle (in any integer type that holds it exactly): a
+/// zero area is dropped whatever `cull` says, a non-zero one when its sign is the culled one. Every set-up of
+/// [`crate::Rasterizer::draw`] (any format) and of [`crate::Rasterizer::draw_wireframe`] tests it, and [`culls`]
+/// before them.
+#[inline(always)]
+pub(crate) fn culls_area<A: PartialOrd + Default>(cull: Cull, area: A) -> bool {
+    let zero = A::default();
+    match cull {
+        _ if area == zero => true,
+        Cull::Cw if area > zero => true,
+        Cull::Ccw if area < zero => true,
+        _ => false,
+    }
+}
+
+/// Whether `cull` drops the snapped triangle `p` ([`culls_area`]), tested only where `cull` culls: without culling
+/// the draw drops a degenerate triangle itself. Snapped coordinates lie in the guard band (below `2^20` units):
+/// differences below `2^21`, products below `2^42` ([`crate::fast::smul_wide`]: no `__aeabi_lmul` call on the
+/// Cortex-M0).
 #[inline]
 pub(crate) fn culls(cull: Cull, p: &[Sub; 3]) -> bool {
     use crate::fast::smul_wide;
-    let area = || {
-        let [p0, p1, p2] = *p;
-        smul_wide(p1.x - p0.x, p2.y - p0.y) - smul_wide(p2.x - p0.x, p1.y - p0.y)
-    };
+    let [p0, p1, p2] = *p;
     match cull {
         Cull::None => false,
-        Cull::Cw => area() >= 0,
-        Cull::Ccw => area() <= 0,
+        _ => culls_area(
+            cull,
+            smul_wide(p1.x - p0.x, p2.y - p0.y) - smul_wide(p2.x - p0.x, p1.y - p0.y),
+        ),
     }
 }
 
