@@ -1816,4 +1816,100 @@ mod tests {
             [29, 29, 28, 27, 24, 23, 17]
         );
     }
+
+    /// [`Rasterizer::draw_gouraud`] hands the target each row's passing run whole: one `fill_contiguous` a run, split
+    /// only where its 32-pixel buffer fills, and no pixel by `draw_iter`. A 120 px triangle over a stored surface
+    /// that fails in blocks of 7 columns (upper rows: runs of up to 14) and passes everywhere below (runs of up to
+    /// 60, split at 32): the calls cover exactly the written pixels, each once; two calls meet on a row only where
+    /// the first holds 32 pixels.
+    #[cfg(feature = "gouraud")]
+    #[test]
+    fn a_gouraud_run_reaches_the_target_whole() {
+        use embedded_graphics_core::geometry::OriginDimensions;
+        use embedded_graphics_core::Pixel;
+        struct Calls(std::vec::Vec<Rectangle>);
+        impl OriginDimensions for Calls {
+            fn size(&self) -> Size {
+                Size::new(128, 64)
+            }
+        }
+        impl DrawTarget for Calls {
+            type Color = Rgb888;
+            type Error = core::convert::Infallible;
+            fn draw_iter<I: IntoIterator<Item = Pixel<Rgb888>>>(
+                &mut self,
+                _: I,
+            ) -> Result<(), Self::Error> {
+                panic!("a pixel outside a run");
+            }
+            fn fill_contiguous<I: IntoIterator<Item = Rgb888>>(
+                &mut self,
+                area: &Rectangle,
+                colors: I,
+            ) -> Result<(), Self::Error> {
+                assert_eq!(
+                    colors.into_iter().count() as u32,
+                    area.size.width * area.size.height
+                );
+                self.0.push(*area);
+                Ok(())
+            }
+        }
+        let stored = |x: usize, y: usize| {
+            if y < 32 && (x / 7).is_multiple_of(3) {
+                0
+            } else {
+                u16::MAX
+            }
+        };
+        let mut d: std::vec::Vec<u16> = (0..128 * 64).map(|k| stored(k % 128, k / 128)).collect();
+        let v = [(2.0, 1.0), (122.0, 3.0), (60.0, 62.0)]
+            .map(|(x, y)| Vertex::new(x, y, 10.0, Rgb888::new(x as u8, y as u8 * 4, 200)));
+        let mut calls = Calls(std::vec::Vec::new());
+        let mut r: Rasterizer = Rasterizer::new(RenderState::new(1.0, 100.0).unwrap());
+        let st = r
+            .draw_gouraud(
+                &mut calls,
+                &mut DepthBuffer::new(&mut d, 128, 64).unwrap(),
+                &v,
+            )
+            .unwrap();
+        let mut covered = std::vec![false; 128 * 64];
+        for a in &calls.0 {
+            assert!(
+                a.size.height == 1 && (1..=32).contains(&a.size.width),
+                "{a:?}"
+            );
+            for x in a.top_left.x..a.top_left.x + a.size.width as i32 {
+                let k = (a.top_left.y * 128 + x) as usize;
+                assert!(!covered[k], "written twice at {x}");
+                covered[k] = true;
+            }
+        }
+        let written: std::vec::Vec<bool> = (0..128 * 64)
+            .map(|k| d[k] != stored(k % 128, k / 128))
+            .collect();
+        assert_eq!(covered, written);
+        let mut rows = calls.0.clone();
+        rows.sort_by_key(|a| (a.top_left.y, a.top_left.x));
+        let (mut met, mut gaps) = (0, 0);
+        for p in rows.windows(2) {
+            if p[0].top_left.y == p[1].top_left.y {
+                if p[0].top_left.x + p[0].size.width as i32 == p[1].top_left.x {
+                    assert_eq!(
+                        p[0].size.width, 32,
+                        "a run split short: {:?} {:?}",
+                        p[0], p[1]
+                    );
+                    met += 1;
+                } else {
+                    gaps += 1;
+                }
+            }
+        }
+        // Both cases occur: runs split at the buffer's size, and runs parted by failing pixels (14 and 118 when
+        // written).
+        assert!(met > 10 && gaps > 100, "{met} {gaps}");
+        assert_eq!(st.written as usize, written.iter().filter(|&&w| w).count());
+    }
 }
