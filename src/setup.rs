@@ -318,7 +318,7 @@ pub(crate) fn t_at_snapped<const NARROW: bool>(s: &Setup) -> Option<[i64; 3]> {
 /// [`t_at_snapped`] of a triangle as it reaches a draw of a list: none, without their work, where the render state's
 /// `cull` drops it (a culled triangle reads no values; the draw culls it by the same test before it would), where a
 /// triangle of a mesh is culled before its draw ([`TMemo::early_cull`]). Out of line beside it: the terrain drawn
-/// with [`Cull::Ccw`] on the M4 takes 23.7% fewer instructions (README, "Culling a list's triangles"), and a draw that
+/// with [`Cull::Ccw`] on the M4 takes 23.6% fewer instructions (README, "Culling a list's triangles"), and a draw that
 /// never culls keeps its code but for the call's argument (a culled triangle's early return from the draw itself saved
 /// more, but took the M0's standard scenes 72 bytes deeper into its stack).
 #[inline(never)]
