@@ -1890,10 +1890,9 @@ mod tests {
             .map(|k| d[k] != stored(k % 128, k / 128))
             .collect();
         assert_eq!(covered, written);
-        let mut rows = calls.0.clone();
-        rows.sort_by_key(|a| (a.top_left.y, a.top_left.x));
+        calls.0.sort_by_key(|a| (a.top_left.y, a.top_left.x));
         let (mut met, mut gaps) = (0, 0);
-        for p in rows.windows(2) {
+        for p in calls.0.windows(2) {
             if p[0].top_left.y == p[1].top_left.y {
                 if p[0].top_left.x + p[0].size.width as i32 == p[1].top_left.x {
                     assert_eq!(

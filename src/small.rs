@@ -1070,9 +1070,10 @@ mod tests {
 
     /// The cull rule written out in [`draw_as`] is [`crate::setup::culls_area`]'s, and so is every other draw's:
     /// triangles on the snap grid (no early cull decides first) of both windings and degenerate ones (three
-    /// collinear vertices), small (this path) and 40 px (the general set-up), with every cull mode. Each draw, the
-    /// fast tier's (both seeds: table and division), the exact tier's, the generic span loop's, W16F's and the wireframe, culls exactly
-    /// the triangles whose snapped doubled area (here in `i64` from the coordinates) is zero or of the culled sign.
+    /// collinear vertices), small (this path) and 40 px (the general set-up), with every cull mode. Each draw (the
+    /// fast tier's with both seeds, table and division; the exact tier's; the generic span loop's; W16F's; the
+    /// wireframe) culls exactly the triangles whose snapped doubled area (here in `i64` from the coordinates) is zero
+    /// or of the culled sign.
     #[test]
     fn the_cull_rule_is_written_out_the_same() {
         use crate::format::W16F;
@@ -1106,6 +1107,9 @@ mod tests {
                     });
                     let mut state = RenderState::new(1.0, 100.0).unwrap();
                     state.cull = cull;
+                    fn db(d: &mut [u16]) -> DepthBuffer<'_> {
+                        DepthBuffer::new(d, 64, 64).unwrap()
+                    }
                     let culled = |draw: &dyn Fn(&mut Frame, &mut [u16]) -> Stats| {
                         let (mut f, mut d) = (Frame(vec![0; 64 * 64]), vec![u16::MAX; 64 * 64]);
                         draw(&mut f, &mut d).culled
@@ -1113,22 +1117,22 @@ mod tests {
                     let got = [
                         culled(&|f, d| {
                             Rasterizer::<Fast>::new(state)
-                                .draw(f, &mut DepthBuffer::new(d, 64, 64).unwrap(), &v)
+                                .draw(f, &mut db(d), &v)
                                 .unwrap()
                         }),
                         culled(&|f, d| {
                             Rasterizer::<crate::recip::FastDiv>::new(state)
-                                .draw(f, &mut DepthBuffer::new(d, 64, 64).unwrap(), &v)
+                                .draw(f, &mut db(d), &v)
                                 .unwrap()
                         }),
                         culled(&|f, d| {
                             Rasterizer::<Exact>::new(state)
-                                .draw(f, &mut DepthBuffer::new(d, 64, 64).unwrap(), &v)
+                                .draw(f, &mut db(d), &v)
                                 .unwrap()
                         }),
                         culled(&|f, d| {
                             Rasterizer::<Fast>::new(state)
-                                .draw_generic(f, &mut DepthBuffer::new(d, 64, 64).unwrap(), &v)
+                                .draw_generic(f, &mut db(d), &v)
                                 .unwrap()
                         }),
                         culled(&|f, _| {
@@ -1139,7 +1143,7 @@ mod tests {
                         }),
                         culled(&|f, d| {
                             Rasterizer::<Fast>::new(state)
-                                .draw_wireframe(f, &mut DepthBuffer::new(d, 64, 64).unwrap(), &v)
+                                .draw_wireframe(f, &mut db(d), &v)
                                 .unwrap()
                         }),
                     ];
@@ -1152,8 +1156,7 @@ mod tests {
                         // The small path took it (culled or drawn), so its own test decided.
                         let s = Rasterizer::<Exact>::new(state).setup(&v).unwrap();
                         let (mut f, mut d) = (Frame(vec![0; 64 * 64]), vec![u16::MAX; 64 * 64]);
-                        let mut db = DepthBuffer::new(&mut d, 64, 64).unwrap();
-                        let st = drawn::<Chord>(&mut f, &mut db, &s, &state).unwrap();
+                        let st = drawn::<Chord>(&mut f, &mut db(&mut d), &s, &state).unwrap();
                         assert_eq!(st.culled, u32::from(rule), "{cull:?} shape {shape}");
                     }
                 }
